@@ -1,0 +1,16 @@
+//! ehl-petsc: full-system finite-element solver for elastohydrodynamic lubrication (EHL)
+//! of circular contacts under rolling, sliding and spinning.
+//!
+//! Layout (one folder per concern):
+//! - [`case`]: the scene file (schema, units, validation).
+//! - [`physics`]: Hertz theory, equivalent solid, lubricant laws, as small pure functions.
+//! - [`mesh`]: graded P2 tetrahedral mesh of the equivalent cube, contact face, partition.
+//! - [`fem`]: quadrature, reference elements and element kernels (pure, PETSc-free).
+//! - [`petsc`]: FFI bindings and safe RAII wrappers; no physics.
+//! - [`output`]: summary.json and other result files.
+pub mod case;
+pub mod fem;
+pub mod mesh;
+pub mod output;
+pub mod petsc;
+pub mod physics;
