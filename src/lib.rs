@@ -8,9 +8,11 @@
 //! - [`fem`]: quadrature, reference elements and element kernels (pure, PETSc-free).
 //! - [`petsc`]: FFI bindings and safe RAII wrappers; no physics.
 //! - [`output`]: summary.json and other result files.
+pub mod app;
 pub mod case;
 pub mod fem;
 pub mod mesh;
 pub mod output;
 pub mod petsc;
 pub mod physics;
+pub mod solid;

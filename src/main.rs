@@ -1,1 +1,64 @@
-fn main() {}
+//! Command line of ehl-petsc: `ehl-petsc [OPTIONS] SCENE.toml [PETSc options...]`.
+use clap::{ArgAction, Parser};
+use std::path::PathBuf;
+
+const AFTER_HELP: &str = "\
+PETSc options follow the scene file and go to PETSc unchanged (PETSC_OPTIONS works too):
+  mpirun -n 2 ehl-petsc cases/dry-hertz.toml -ksp_view -log_view
+  ehl-petsc cases/dry-hertz.toml -pc_type gamg -ksp_type cg -ksp_rtol 1e-10
+Defaults: -ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps -mat_mumps_icntl_7 4 (PORD).
+Useful: -log_view, -ksp_view, -options_left (lists options nobody used), -mat_mumps_icntl_4 2.
+Exit codes: 0 success, 1 solve failed or did not converge, 2 bad scene or output folder, 3 PETSc start-up.";
+
+/// Full-system FEM solver for elastohydrodynamic lubrication (EHL) of circular contacts
+/// under rolling, sliding and spinning, on PETSc and MPI.
+#[derive(Parser, Debug)]
+#[command(name = "ehl-petsc", version, disable_help_flag = true, disable_version_flag = true, after_help = AFTER_HELP, trailing_var_arg = true)]
+struct Cli {
+    /// Scene file (TOML): geometry, materials, lubricant, operating point, mesh, outputs
+    scene: PathBuf,
+    /// PETSc options, e.g. -ksp_view -log_view -snes_monitor (single dash, after the scene)
+    #[arg(allow_hyphen_values = true, value_name = "PETSC_OPTIONS")]
+    petsc_args: Vec<String>,
+    /// Output folder (default: the scene's output.dir)
+    #[arg(long, value_name = "DIR")]
+    output: Option<PathBuf>,
+    /// Validate the scene file and exit without solving
+    #[arg(long)]
+    check: bool,
+    /// Print only errors
+    #[arg(long)]
+    quiet: bool,
+    /// Print help (PETSc's own help: -help after the scene)
+    #[arg(long, action = ArgAction::Help)]
+    help: Option<bool>,
+    /// Print version
+    #[arg(long, action = ArgAction::Version)]
+    version: Option<bool>,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let Some(universe) = mpi::initialize() else {
+        eprintln!("ehl-petsc: error: MPI could not be initialised");
+        std::process::exit(3);
+    };
+    let world = universe.world();
+    // A panic on one rank must not leave the others waiting: abort the whole job.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        default_hook(info);
+        eprintln!("ehl-petsc: internal error, aborting all MPI ranks");
+        unsafe { mpi::ffi::MPI_Abort(mpi::ffi::RSMPI_COMM_WORLD, 70) };
+    }));
+    let opts = ehl_petsc::app::RunOptions {
+        scene: cli.scene,
+        output: cli.output,
+        petsc_args: cli.petsc_args,
+        check_only: cli.check,
+        quiet: cli.quiet,
+    };
+    let code = ehl_petsc::app::run(world, opts);
+    drop(universe);
+    std::process::exit(code);
+}

@@ -1,0 +1,32 @@
+//! Making failures collective: an error on one rank must end every rank cleanly,
+//! never leave the others waiting in a collective call.
+use mpi::collective::SystemOperation;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+
+/// Every rank passes its local outcome; all ranks get `Ok` only if all succeeded. The
+/// failing ranks keep their own message; the others learn that a peer failed.
+pub fn agree<T>(world: &SimpleCommunicator, local: Result<T, String>) -> Result<T, String> {
+    let flag: i32 = if local.is_ok() { 1 } else { 0 };
+    let mut all: i32 = 0;
+    world.all_reduce_into(&flag, &mut all, SystemOperation::min());
+    match local {
+        Ok(v) if all == 1 => Ok(v),
+        Ok(_) => Err("another MPI rank failed (see its message above)".into()),
+        Err(e) => Err(e),
+    }
+}
+
+/// The maximum of a value over all ranks.
+pub fn max_f64(world: &SimpleCommunicator, v: f64) -> f64 {
+    let mut out = 0.0;
+    world.all_reduce_into(&v, &mut out, SystemOperation::max());
+    out
+}
+
+/// The sum of a value over all ranks.
+pub fn sum_f64(world: &SimpleCommunicator, v: f64) -> f64 {
+    let mut out = 0.0;
+    world.all_reduce_into(&v, &mut out, SystemOperation::sum());
+    out
+}

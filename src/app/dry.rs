@@ -1,0 +1,125 @@
+//! The dry Hertz scene: the Hertzian pressure applied as a traction on the contact face of
+//! the equivalent solid, one linear elastic solve, and the surface deflection compared with
+//! the half-space solution (physics.md sections 2 and 6).
+use super::{collective, Context};
+use crate::case::Scene;
+use crate::mesh::{self, Mesh};
+use crate::petsc::{self, Ksp, Vector};
+use crate::solid::{assembly, dofmap::DofMap, hertz_load};
+use serde_json::json;
+use std::time::Instant;
+
+/// Depth of the recursive splitting of contact triangles cut by the Hertz circle.
+const HERTZ_SPLIT_DEPTH: u32 = 6;
+
+/// Builds the mesh described by the scene (every rank builds the same mesh).
+pub fn build_mesh(scene: &Scene, half_z: bool) -> Result<Mesh, String> {
+    let spec = mesh::MeshSpec {
+        cube_edge: scene.mesh.cube_size,
+        depth: scene.mesh.cube_size,
+        half_z,
+        contact: mesh::Rect { x0: scene.reynolds.x_min, x1: scene.reynolds.x_max, z0: scene.reynolds.z_min, z1: if half_z { 0.0 } else { scene.reynolds.z_max } },
+        contact_size: scene.mesh.contact_size,
+        growth: scene.mesh.growth,
+    };
+    mesh::generate(&spec).map_err(|e| format!("mesh: {e}"))
+}
+
+/// Value of the y displacement (dimensionless U) at (x, z) on the contact face.
+pub fn contact_uy(mesh: &Mesh, dofs: &DofMap, sol: &[f64], x: f64, z: f64) -> Result<f64, String> {
+    let (tri, bary) = mesh.locate_contact(x, z).ok_or_else(|| format!("point ({x}, {z}) is not on the contact face"))?;
+    let nodes = mesh.contact_tris[tri];
+    let vals = nodes.map(|n| {
+        let d = dofs.node_dof[n as usize][1];
+        if d < 0 { 0.0 } else { sol[d as usize] }
+    });
+    Ok(crate::fem::p2tri::eval(&vals, &bary))
+}
+
+pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
+    let pe = |e: petsc::PetscError| e.to_string();
+    let hertz = scene.hertz();
+    let eq = scene.equivalent_solid();
+    let comm = petsc::comm_world();
+    ctx.log(format!("Hertz: a = {:.5e} m, p_H = {:.5e} Pa; equivalent solid E = {:.4e} Pa, nu = {:.4}", hertz.a, hertz.ph, eq.e, eq.nu));
+
+    let t0 = Instant::now();
+    let mesh = build_mesh(scene, false)?;
+    let part = mesh::partition(&mesh, ctx.size);
+    let quality = mesh::quality(&mesh);
+    let dofs = DofMap::new(&mesh, &part, ctx.size);
+    let mesh_s = t0.elapsed().as_secs_f64();
+    ctx.log(format!(
+        "mesh: {} P2 tetrahedra, {} nodes, {} contact triangles, h_c = {} a, {} displacement unknowns, worst dihedral {:.1} deg",
+        mesh.tets.len(), mesh.nodes.len(), mesh.contact_tris.len(), mesh.contact_size, dofs.total(), quality.min_dihedral_deg
+    ));
+
+    let t1 = Instant::now();
+    let k = assembly::assemble_stiffness(comm, &mesh, &part, &dofs, ctx.rank, eq.nu).map_err(pe)?;
+    let factor = assembly::traction_factor(eq.nu);
+    let b = assembly::assemble_pressure_load(comm, &mesh, &part, &dofs, ctx.rank, factor, &|v| hertz_load::hertz_p2_load(v, HERTZ_SPLIT_DEPTH)).map_err(pe)?;
+    let assembly_s = t1.elapsed().as_secs_f64();
+    // Load check: the assembled traction sums to -factor * integral of P = -factor * 2 pi / 3.
+    let load_num = {
+        let local = b.local_values().map_err(pe)?;
+        collective::sum_f64(&ctx.world, local.iter().sum::<f64>())
+    };
+    let load_exact = -factor * 2.0 * std::f64::consts::PI / 3.0;
+    let load_error_rel = (load_num - load_exact).abs() / load_exact.abs();
+    ctx.log(format!("assembly: {:.2} s, {:.0} non-zeros; traction load error {:.2e}", assembly_s, k.nonzeros().map_err(pe)?, load_error_rel));
+
+    let t2 = Instant::now();
+    petsc::ksp::set_direct_solver_defaults("").map_err(pe)?;
+    let ksp = Ksp::new(comm, &k).map_err(pe)?;
+    let x = Vector::new(comm, dofs.local(ctx.rank)).map_err(pe)?;
+    let its = ksp.solve(&b, &x).map_err(pe)?;
+    let solve_s = t2.elapsed().as_secs_f64();
+    ctx.log(format!("solve: {:.2} s ({} KSP iteration(s))", solve_s, its));
+
+    let sol = x.gather_all().map_err(pe)?;
+    let scale = hertz.a * hertz.a / scene.geometry.ball_radius; // U -> metres
+    let u_c = contact_uy(&mesh, &dofs, &sol, 0.0, 0.0)?;
+    let u_a = contact_uy(&mesh, &dofs, &sol, 1.0, 0.0)?;
+    ctx.log(format!(
+        "deflection: U(0) = {:.5} (half-space -1), U(0) - U(a) = {:.5} (half-space -0.5)",
+        u_c, u_c - u_a
+    ));
+    let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
+    let peak_total = collective::sum_f64(&ctx.world, crate::output::peak_rss_mb());
+    let total_s = ctx.start.elapsed().as_secs_f64();
+    if ctx.rank == 0 {
+        let summary = json!({
+            "case": scene.name,
+            "ranks": ctx.size,
+            "converged": true,
+            "hertz": { "a_m": hertz.a, "ph_pa": hertz.ph, "e_prime_pa": hertz.e_prime },
+            "equivalent_solid": { "e_pa": eq.e, "nu": eq.nu },
+            "mesh": {
+                "elements": mesh.tets.len(),
+                "nodes": mesh.nodes.len(),
+                "dofs_total": dofs.total(),
+                "contact_triangles": mesh.contact_tris.len(),
+                "contact_size_a": mesh.contact_size,
+                "worst_quality": quality.min_dihedral_deg,
+                "worst_quality_measure": "minimum dihedral angle (degrees)",
+                "max_aspect_ratio": quality.max_aspect_ratio,
+            },
+            "elastic": {
+                "u2_center_m": u_c * scale,
+                "u2_edge_m": u_a * scale,
+                "u2_center_halfspace_m": -scale,
+                "u2_difference_halfspace_m": -0.5 * scale,
+                "traction_load_error_rel": load_error_rel,
+            },
+            "timing": { "mesh_s": mesh_s, "assembly_s": assembly_s, "solve_s": solve_s, "total_s": total_s },
+            "peak_rss_mb": peak,
+            "peak_rss_mb_all_ranks": peak_total,
+            "scene": scene,
+        });
+        let path = ctx.out_dir.join("summary.json");
+        let text = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
+        crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        ctx.log(format!("wrote {}", path.display()));
+    }
+    Ok(())
+}

@@ -1,0 +1,102 @@
+//! The program: reads the scene, starts PETSc, runs the simulation the scene asks for and
+//! writes the results. `main.rs` only parses the command line and calls [`run`].
+pub mod collective;
+pub mod dry;
+
+use crate::case::Scene;
+use crate::petsc::Petsc;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// What the command line asked for.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    pub scene: PathBuf,
+    pub output: Option<PathBuf>,
+    pub petsc_args: Vec<String>,
+    pub check_only: bool,
+    pub quiet: bool,
+}
+
+/// Shared state of one run on one rank.
+pub struct Context {
+    pub world: SimpleCommunicator,
+    pub rank: usize,
+    pub size: usize,
+    pub out_dir: PathBuf,
+    pub quiet: bool,
+    pub start: Instant,
+}
+
+impl Context {
+    /// Prints a progress line on rank 0 (stdout), with the elapsed time.
+    pub fn log(&self, msg: impl AsRef<str>) {
+        if self.rank == 0 && !self.quiet {
+            println!("[{:7.2} s] {}", self.start.elapsed().as_secs_f64(), msg.as_ref());
+        }
+    }
+}
+
+/// Runs the program on every rank; returns the process exit code. Errors are printed by
+/// rank 0 (or by the rank that failed alone) on stderr.
+pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
+    let rank = world.rank() as usize;
+    let size = world.size() as usize;
+    let start = Instant::now();
+    // The scene is read and validated on every rank: the outcome is the same everywhere.
+    let scene = match crate::case::load_scene(&opts.scene) {
+        Ok(s) => s,
+        Err(e) => {
+            if rank == 0 {
+                eprintln!("ehl-petsc: error: {e}");
+            }
+            return 2;
+        }
+    };
+    if opts.check_only {
+        if rank == 0 {
+            println!("ehl-petsc: scene '{}' is valid", opts.scene.display());
+        }
+        return 0;
+    }
+    let out_dir = opts.output.clone().unwrap_or_else(|| PathBuf::from(&scene.output.dir));
+    // The output folder is checked before any solve starts (by rank 0, outcome shared).
+    let ready = if rank == 0 { crate::output::prepare_output_dir(&out_dir) } else { Ok(()) };
+    if let Err(e) = collective::agree(&world, ready) {
+        if rank == 0 {
+            eprintln!("ehl-petsc: error: {e}");
+        }
+        return 2;
+    }
+    let mut petsc_argv = vec!["ehl-petsc".to_string()];
+    petsc_argv.extend(opts.petsc_args.iter().cloned());
+    let petsc = match Petsc::init(&petsc_argv) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("ehl-petsc: error: cannot initialise PETSc: {e}");
+            return 3;
+        }
+    };
+    let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
+    ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
+    let result = simulate(&ctx, &scene);
+    let code = match collective::agree(&ctx.world, result) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("ehl-petsc: error (rank {rank}): {e}");
+            1
+        }
+    };
+    drop(petsc);
+    code
+}
+
+/// Dispatches on what the scene asks to simulate.
+fn simulate(ctx: &Context, scene: &Scene) -> Result<(), String> {
+    match scene.effects.lubrication {
+        crate::case::Lubrication::None => dry::run(ctx, scene),
+        _ => Err("the lubricated (Reynolds) solver is not implemented yet: set effects.lubrication = \"none\" for the dry Hertz scene".into()),
+    }
+}

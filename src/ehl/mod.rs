@@ -1,0 +1,5 @@
+//! The full-system EHL solver: unknown layout, preallocation, residual and exact Jacobian
+//! of the coupled elasticity + Reynolds + load-balance system, and the Newton driver.
+pub mod layout;
+pub mod prealloc;
+pub mod system;

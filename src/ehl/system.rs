@@ -1,0 +1,340 @@
+//! The monolithic EHL system: residual and exact Jacobian of
+//!   elasticity:      K U + c M^T P = 0                    (U rows; c = E'/(pi E_eq))
+//!   Reynolds:        R(P, H(U, H0)) + penalty(P) = 0       (P rows)
+//!   load balance:    integral of P over the Reynolds domain - W = 0   (H0 row)
+//! with the film H = H0 + (X^2 + Z^2)/2 - U_y (physics.md Eq. 5, dimensionless).
+//! Only the Reynolds rows depend on the iterate, so after the first assembly the Jacobian
+//! keeps its U and H0 rows and only the P rows are zeroed and refilled.
+use super::layout::Layout;
+use crate::mesh::{Mesh, Partition};
+use crate::petsc::snes::{Eval, Problem};
+use crate::petsc::{ffi, Matrix, Result, Vector};
+use crate::pcall;
+use crate::reynolds::element::{reynolds_element, Fluid, Stabilisation};
+use crate::solid::dofmap::DofMap;
+use mpi::topology::SimpleCommunicator;
+
+/// Mass matrix of a straight P2 triangle, integral of N_i N_j (closed form, area/180 * ...).
+pub fn p2_tri_mass(area: f64) -> [[f64; 6]; 6] {
+    const M: [[f64; 6]; 6] = [
+        [6., -1., -1., 0., -4., 0.],
+        [-1., 6., -1., 0., 0., -4.],
+        [-1., -1., 6., -4., 0., 0.],
+        [0., 0., -4., 32., 16., 16.],
+        [-4., 0., 0., 16., 32., 16.],
+        [0., -4., 0., 16., 16., 32.],
+    ];
+    M.map(|row| row.map(|m| m * area / 180.0))
+}
+
+/// Signed-area-free triangle area in the (X, Z) plane.
+pub fn tri_area(v: &[[f64; 2]; 3]) -> f64 {
+    0.5 * ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1])).abs()
+}
+
+/// Integral of the P2 basis functions over a triangle: 0 at vertices, area/3 at midpoints.
+pub fn p2_tri_weights(area: f64) -> [f64; 6] {
+    [0.0, 0.0, 0.0, area / 3.0, area / 3.0, area / 3.0]
+}
+
+/// Lubricant laws in dimensionless form: eta_bar(P), rho_bar(P) with their P-derivatives.
+pub struct Lubricant {
+    pub eta: Box<dyn Fn(f64) -> (f64, f64) + Send + Sync>,
+    pub rho: Box<dyn Fn(f64) -> (f64, f64) + Send + Sync>,
+}
+
+/// Everything the EHL residual needs besides the iterate.
+pub struct EhlParams {
+    /// lambda_bar = 12 eta_R Ue R^2 / (a^3 p_H).
+    pub lambda_bar: f64,
+    /// Traction factor c = E'/(pi E_eq).
+    pub traction: f64,
+    /// Load target W = integral of P (2 pi / 3 on the full domain, pi / 3 on a half domain).
+    pub load: f64,
+    /// Cavitation penalty factor xi (dimensionless, per unit nodal area).
+    pub penalty: f64,
+    pub stabilisation: Stabilisation,
+    /// Dimensionless entrainment velocity (Um, Wm)/Ue as a function of (X, Z).
+    pub velocity: Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync>,
+    /// Poisson ratio of the equivalent solid.
+    pub nu: f64,
+}
+
+/// One contact triangle as the Reynolds assembly sees it.
+struct ContactElement {
+    nodes: [u32; 6],
+    verts: [[f64; 2]; 3],
+    vel: [[f64; 2]; 3],
+    /// (X^2 + Z^2)/2 at the 6 nodes: the rigid gap of the ball.
+    gap: [f64; 6],
+    area: f64,
+}
+
+/// The EHL problem on one rank.
+pub struct EhlSystem<'a> {
+    pub world: &'a SimpleCommunicator,
+    pub mesh: &'a Mesh,
+    pub part: &'a Partition,
+    pub dofs: &'a DofMap,
+    pub layout: &'a Layout,
+    pub rank: usize,
+    pub params: EhlParams,
+    pub lubricant: Lubricant,
+    /// Stiffness in the displacement-only numbering of `dofs` (for K U).
+    stiffness: Matrix,
+    elements: Vec<ContactElement>,
+    /// Nodal penalty weights (area of the node's share of its triangles) of owned P nodes.
+    penalty_nodes: Vec<(i32, u32, f64)>,
+    jacobian_built: bool,
+    /// Global P rows this rank owns (zeroed and refilled at each Jacobian).
+    p_rows: Vec<i32>,
+    u_work: Vector,
+    ku_work: Vector,
+    /// Counters for reports.
+    pub residual_evals: usize,
+    pub jacobian_evals: usize,
+}
+
+impl<'a> EhlSystem<'a> {
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        world: &'a SimpleCommunicator,
+        mesh: &'a Mesh,
+        part: &'a Partition,
+        dofs: &'a DofMap,
+        layout: &'a Layout,
+        rank: usize,
+        params: EhlParams,
+        lubricant: Lubricant,
+        stiffness: Matrix,
+    ) -> Result<Self> {
+        let mut elements = Vec::new();
+        for (t, tri) in mesh.contact_tris.iter().enumerate() {
+            if part.tet_rank[mesh.contact_tri_tet[t] as usize] as usize != rank {
+                continue;
+            }
+            let xz = |n: u32| {
+                let c = mesh.nodes[n as usize];
+                [c[0], c[2]]
+            };
+            let verts = [xz(tri[0]), xz(tri[1]), xz(tri[2])];
+            let vel = verts.map(|v| (params.velocity)(v[0], v[1]));
+            let gap = tri.map(|n| {
+                let c = mesh.nodes[n as usize];
+                0.5 * (c[0] * c[0] + c[2] * c[2])
+            });
+            elements.push(ContactElement { nodes: *tri, verts, vel, gap, area: tri_area(&verts) });
+        }
+        // Nodal areas for the penalty, from all contact triangles (every rank sees the mesh).
+        let mut node_area = std::collections::HashMap::<u32, f64>::new();
+        for tri in &mesh.contact_tris {
+            let xz = |n: u32| {
+                let c = mesh.nodes[n as usize];
+                [c[0], c[2]]
+            };
+            let a = tri_area(&[xz(tri[0]), xz(tri[1]), xz(tri[2])]);
+            for &n in tri {
+                *node_area.entry(n).or_insert(0.0) += a / 6.0;
+            }
+        }
+        let (lo, hi) = (layout.ranges[rank] as i32, layout.ranges[rank + 1] as i32);
+        let mut penalty_nodes: Vec<(i32, u32, f64)> = mesh
+            .contact_nodes
+            .iter()
+            .filter_map(|&n| {
+                let d = layout.p[n as usize];
+                (d >= lo && d < hi).then(|| (d, n, node_area[&n]))
+            })
+            .collect();
+        penalty_nodes.sort_unstable_by_key(|e| e.0);
+        let p_rows = penalty_nodes.iter().map(|e| e.0).collect();
+        let comm = crate::petsc::comm_world();
+        let u_work = Vector::new(comm, dofs.local(rank))?;
+        let ku_work = u_work.duplicate()?;
+        Ok(EhlSystem {
+            world,
+            mesh,
+            part,
+            dofs,
+            layout,
+            rank,
+            params,
+            lubricant,
+            stiffness,
+            elements,
+            penalty_nodes,
+            jacobian_built: false,
+            p_rows,
+            u_work,
+            ku_work,
+            residual_evals: 0,
+            jacobian_evals: 0,
+        })
+    }
+
+    /// Nodal film thickness H = H0 + gap - U_y at the 6 nodes of a contact element.
+    fn element_film(&self, x: &[f64], e: &ContactElement) -> [f64; 6] {
+        let h0 = x[self.layout.h0 as usize];
+        let mut h = [0.0; 6];
+        for i in 0..6 {
+            let d = self.layout.u[e.nodes[i] as usize][1];
+            let uy = if d < 0 { 0.0 } else { x[d as usize] };
+            h[i] = h0 + e.gap[i] - uy;
+        }
+        h
+    }
+
+    fn element_pressure(&self, x: &[f64], e: &ContactElement) -> [f64; 6] {
+        e.nodes.map(|n| {
+            let d = self.layout.p[n as usize];
+            if d < 0 { 0.0 } else { x[d as usize] }
+        })
+    }
+
+    fn fluid(&self) -> Fluid<'_> {
+        Fluid { eta: &*self.lubricant.eta, rho: &*self.lubricant.rho, lambda_bar: self.params.lambda_bar }
+    }
+
+    /// Film thickness at every contact node (whole mesh; used by post-processing).
+    pub fn nodal_film(&self, x: &[f64]) -> Vec<(u32, f64)> {
+        let h0 = x[self.layout.h0 as usize];
+        self.mesh
+            .contact_nodes
+            .iter()
+            .map(|&n| {
+                let c = self.mesh.nodes[n as usize];
+                let d = self.layout.u[n as usize][1];
+                let uy = if d < 0 { 0.0 } else { x[d as usize] };
+                (n, h0 + 0.5 * (c[0] * c[0] + c[2] * c[2]) - uy)
+            })
+            .collect()
+    }
+
+    /// Writes the iterate's displacement block into the displacement-only work vector.
+    fn load_u(&self, x: &[f64]) -> Result<()> {
+        let base = self.layout.ranges[self.rank];
+        self.u_work.set_local_values(&x[base..base + self.layout.n_u[self.rank]])
+    }
+
+    /// Adds K (in layout numbering) into J, element by element (first Jacobian only).
+    fn add_stiffness(&self, j: &Matrix) -> Result<()> {
+        let (lambda, mu) = crate::fem::elasticity::lame(1.0, self.params.nu);
+        for (k, tet) in self.mesh.tets.iter().enumerate() {
+            if self.part.tet_rank[k] as usize != self.rank {
+                continue;
+            }
+            let ke = crate::fem::elasticity::elasticity_stiffness(&crate::solid::assembly::tet_vertices(self.mesh, tet), lambda, mu);
+            let mut idx = [-1i32; 30];
+            for (i, &n) in tet.iter().enumerate() {
+                idx[3 * i..3 * i + 3].copy_from_slice(&self.layout.u[n as usize]);
+            }
+            j.add_values(&idx, &idx, ke.as_flattened())?;
+        }
+        Ok(())
+    }
+
+    /// The constant coupling blocks: c M in the U_y rows and the load-balance row.
+    fn add_constant_couplings(&self, j: &Matrix) -> Result<()> {
+        for e in &self.elements {
+            let m = p2_tri_mass(e.area);
+            let rows: [i32; 6] = e.nodes.map(|n| self.layout.u[n as usize][1]);
+            let cols: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
+            let vals: Vec<f64> = m.iter().flat_map(|r| r.iter().map(|v| v * self.params.traction)).collect();
+            j.add_values(&rows, &cols, &vals)?;
+            let w = p2_tri_weights(e.area);
+            j.add_values(&[self.layout.h0], &cols, &w)?;
+        }
+        Ok(())
+    }
+}
+
+impl Problem for EhlSystem<'_> {
+    fn residual(&mut self, x: &[f64], f: &Vector) -> Result<Eval> {
+        self.residual_evals += 1;
+        // Physical domain: H > 0 at every node of every owned contact element (collective).
+        let mut bad: Option<String> = None;
+        for e in &self.elements {
+            let h = self.element_film(x, e);
+            if let Some(i) = (0..6).find(|&i| !(h[i] > 0.0) || !h[i].is_finite()) {
+                let c = self.mesh.nodes[e.nodes[i] as usize];
+                bad = Some(format!("film thickness H = {:.3e} at (X, Z) = ({:.3}, {:.3})", h[i], c[0], c[2]));
+                break;
+            }
+        }
+        let any_bad = crate::app::collective::max_f64(self.world, if bad.is_some() { 1.0 } else { 0.0 });
+        if any_bad > 0.0 {
+            return Ok(Eval::Domain(bad.unwrap_or_else(|| "non-positive film on another rank".into())));
+        }
+        // Elastic rows: K U + c M^T P.
+        self.load_u(x)?;
+        self.stiffness.mult(&self.u_work, &self.ku_work)?;
+        let ku = self.ku_work.local_values()?;
+        let base = self.layout.ranges[self.rank] as i32;
+        let idx: Vec<i32> = (0..ku.len() as i32).map(|i| base + i).collect();
+        f.set_values(&idx, &ku, true)?;
+        let fluid = self.fluid();
+        let mut load_part = 0.0;
+        for e in &self.elements {
+            let p = self.element_pressure(x, e);
+            let m = p2_tri_mass(e.area);
+            let rows_u: [i32; 6] = e.nodes.map(|n| self.layout.u[n as usize][1]);
+            let mut fu = [0.0; 6];
+            for i in 0..6 {
+                fu[i] = self.params.traction * (0..6).map(|k| m[i][k] * p[k]).sum::<f64>();
+            }
+            f.set_values(&rows_u, &fu, true)?;
+            let w = p2_tri_weights(e.area);
+            load_part += (0..6).map(|k| w[k] * p[k]).sum::<f64>();
+            // Reynolds rows.
+            let h = self.element_film(x, e);
+            let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid, &self.params.stabilisation);
+            let rows_p: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
+            f.set_values(&rows_p, &out.r, true)?;
+        }
+        // Cavitation penalty on owned P nodes: xi * area_i * min(P_i, 0).
+        for &(d, _n, area) in &self.penalty_nodes {
+            let p = x[d as usize];
+            if p < 0.0 {
+                f.set_values(&[d], &[self.params.penalty * area * p], true)?;
+            }
+        }
+        let target = if self.rank == self.layout.ranges.len() - 2 { -self.params.load } else { 0.0 };
+        f.set_values(&[self.layout.h0], &[load_part + target], true)?;
+        Ok(Eval::Ok)
+    }
+
+    fn jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
+        self.jacobian_evals += 1;
+        if !self.jacobian_built {
+            j.zero()?;
+            self.add_stiffness(j)?;
+            self.add_constant_couplings(j)?;
+            pcall!(ffi::MatSetOption(j.raw(), ffi::MatOption_MAT_KEEP_NONZERO_PATTERN, ffi::PetscBool_PETSC_TRUE))?;
+        } else {
+            // Only the Reynolds rows change: zero them (pattern kept) and refill.
+            pcall!(ffi::MatZeroRows(j.raw(), self.p_rows.len() as i32, self.p_rows.as_ptr(), 0.0, std::ptr::null_mut(), std::ptr::null_mut()))?;
+        }
+        let fluid = self.fluid();
+        for e in &self.elements {
+            let p = self.element_pressure(x, e);
+            let h = self.element_film(x, e);
+            let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid, &self.params.stabilisation);
+            let rows_p: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
+            let cols_uy: [i32; 6] = e.nodes.map(|n| self.layout.u[n as usize][1]);
+            // dR/dP
+            j.add_values(&rows_p, &rows_p, out.dr_dp.as_flattened())?;
+            // dR/dU_y = -dR/dH ; dR/dH0 = sum_j dR/dH_j
+            let neg: Vec<f64> = out.dr_dh.iter().flat_map(|r| r.iter().map(|v| -v)).collect();
+            j.add_values(&rows_p, &cols_uy, &neg)?;
+            let dh0: [f64; 6] = out.dr_dh.map(|r| r.iter().sum());
+            j.add_values(&rows_p, &[self.layout.h0], &dh0)?;
+        }
+        for &(d, _n, area) in &self.penalty_nodes {
+            if x[d as usize] < 0.0 {
+                j.add_values(&[d], &[d], &[self.params.penalty * area])?;
+            }
+        }
+        self.jacobian_built = true;
+        Ok(())
+    }
+}

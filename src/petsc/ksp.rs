@@ -1,0 +1,55 @@
+//! RAII wrapper of a PETSc linear solver (KSP), MUMPS LU by default.
+use super::error::{rust_error, Result};
+use super::{ffi, options, Matrix, Vector};
+use crate::pcall;
+use std::ffi::CStr;
+
+/// Solver defaults ehl-petsc sets unless the user gave the option: a direct MUMPS LU
+/// solve with the PORD ordering (the fastest of Debian's built-in MUMPS orderings for 3D
+/// elasticity on this kind of machine).
+pub fn set_direct_solver_defaults(prefix: &str) -> Result<()> {
+    options::set_default(&format!("-{prefix}ksp_type"), "preonly")?;
+    options::set_default(&format!("-{prefix}pc_type"), "lu")?;
+    options::set_default(&format!("-{prefix}pc_factor_mat_solver_type"), "mumps")?;
+    options::set_default("-mat_mumps_icntl_7", "4")?;
+    Ok(())
+}
+
+/// A Krylov solver context (any KSP/PC through PETSc options).
+pub struct Ksp {
+    raw: ffi::KSP,
+}
+
+impl Ksp {
+    /// Creates a solver for operator `a`, configured from the options database.
+    pub fn new(comm: ffi::MPI_Comm, a: &Matrix) -> Result<Ksp> {
+        let mut raw: ffi::KSP = std::ptr::null_mut();
+        pcall!(ffi::KSPCreate(comm, &mut raw))?;
+        let k = Ksp { raw };
+        pcall!(ffi::KSPSetOperators(k.raw, a.raw, a.raw))?;
+        pcall!(ffi::KSPSetFromOptions(k.raw))?;
+        Ok(k)
+    }
+
+    /// Solves A x = b and checks the converged reason (a failed solve is an error).
+    pub fn solve(&self, b: &Vector, x: &Vector) -> Result<usize> {
+        pcall!(ffi::KSPSolve(self.raw, b.raw, x.raw))?;
+        let mut reason: ffi::KSPConvergedReason = 0;
+        pcall!(ffi::KSPGetConvergedReason(self.raw, &mut reason))?;
+        let mut its: ffi::PetscInt = 0;
+        pcall!(ffi::KSPGetIterationNumber(self.raw, &mut its))?;
+        if reason < 0 {
+            let mut s: *const std::os::raw::c_char = std::ptr::null();
+            unsafe { ffi::KSPGetConvergedReasonString(self.raw, &mut s) };
+            let name = if s.is_null() { reason.to_string() } else { unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned() };
+            return Err(rust_error(format!("linear solve failed: KSP reason {name} after {its} iterations")));
+        }
+        Ok(its as usize)
+    }
+}
+
+impl Drop for Ksp {
+    fn drop(&mut self) {
+        unsafe { ffi::KSPDestroy(&mut self.raw) };
+    }
+}

@@ -1,0 +1,37 @@
+//! The PETSc options database: defaults that the user's flags can override.
+use super::error::Result;
+use crate::pcall;
+use std::ffi::CString;
+
+fn cstr(s: &str) -> CString {
+    CString::new(s).expect("option string without NUL")
+}
+
+/// True when the option was given (command line, PETSC_OPTIONS or set earlier).
+pub fn has(name: &str) -> Result<bool> {
+    let n = cstr(name);
+    let mut set: super::ffi::PetscBool = 0;
+    pcall!(super::ffi::PetscOptionsHasName(std::ptr::null_mut(), std::ptr::null(), n.as_ptr(), &mut set))?;
+    Ok(set != 0)
+}
+
+/// Sets `name value` unless the user already gave `name`: our defaults stay overridable.
+pub fn set_default(name: &str, value: &str) -> Result<()> {
+    if has(name)? {
+        return Ok(());
+    }
+    let (n, v) = (cstr(name), cstr(value));
+    pcall!(super::ffi::PetscOptionsSetValue(std::ptr::null_mut(), n.as_ptr(), if value.is_empty() { std::ptr::null() } else { v.as_ptr() }))
+}
+
+/// Reads an option's value as a string, if set.
+pub fn get_string(name: &str) -> Result<Option<String>> {
+    let n = cstr(name);
+    let mut buf = vec![0 as std::os::raw::c_char; 512];
+    let mut set: super::ffi::PetscBool = 0;
+    pcall!(super::ffi::PetscOptionsGetString(std::ptr::null_mut(), std::ptr::null(), n.as_ptr(), buf.as_mut_ptr(), buf.len(), &mut set))?;
+    if set == 0 {
+        return Ok(None);
+    }
+    Ok(Some(unsafe { std::ffi::CStr::from_ptr(buf.as_ptr()) }.to_string_lossy().into_owned()))
+}

@@ -1,0 +1,165 @@
+//! RAII wrapper of PETSc's nonlinear solver (SNES) driving a Rust [`Problem`].
+//!
+//! In the callbacks the current iterate is gathered on every rank (the meshes are
+//! replicated), the problem adds its own elements' contributions to the distributed
+//! residual or Jacobian, and PETSc assembles them. A Rust error inside a callback becomes a
+//! PETSc error code (never a panic across the FFI boundary); an unphysical iterate (for
+//! example a negative film) is reported to SNES as a domain error so the line search
+//! backtracks.
+use super::error::{check, rust_error, PetscError, Result};
+use super::{ffi, Matrix, Vector};
+use crate::pcall;
+use std::ffi::CStr;
+use std::os::raw::c_void;
+
+/// Outcome of a residual evaluation.
+pub enum Eval {
+    /// The residual was assembled.
+    Ok,
+    /// The iterate is outside the physical domain (e.g. negative film thickness).
+    Domain(String),
+}
+
+/// A nonlinear system F(x) = 0 with its exact Jacobian.
+pub trait Problem {
+    /// Adds this rank's contributions to `f` (zeroed beforehand); `x` is the whole iterate.
+    fn residual(&mut self, x: &[f64], f: &Vector) -> Result<Eval>;
+    /// Fills `j` (this rank's contributions; the problem decides what to zero); `x` is the whole iterate.
+    fn jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()>;
+}
+
+struct Context<'a> {
+    problem: &'a mut dyn Problem,
+    domain_error: Option<String>,
+    error: Option<PetscError>,
+}
+
+/// Outcome of a nonlinear solve.
+#[derive(Debug, Clone)]
+pub struct SolveReport {
+    pub converged: bool,
+    pub reason: String,
+    pub reason_code: i32,
+    pub iterations: usize,
+    pub linear_iterations: usize,
+    pub residual_norm: f64,
+    pub domain_error: Option<String>,
+}
+
+/// A PETSc SNES (Newton with line search by default; everything overridable by options).
+pub struct Snes {
+    raw: ffi::SNES,
+}
+
+unsafe extern "C" fn form_function(snes: ffi::SNES, x: ffi::Vec, f: ffi::Vec, ctx: *mut c_void) -> ffi::PetscErrorCode {
+    let ctx = &mut *(ctx as *mut Context);
+    let run = || -> Result<Eval> {
+        let xv = std::mem::ManuallyDrop::new(Vector { raw: x });
+        let fv = std::mem::ManuallyDrop::new(Vector { raw: f });
+        let all = xv.gather_all()?;
+        fv.set_all(0.0)?;
+        let r = ctx.problem.residual(&all, &fv)?;
+        fv.assemble()?;
+        Ok(r)
+    };
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+        Ok(Ok(Eval::Ok)) => 0,
+        Ok(Ok(Eval::Domain(msg))) => {
+            ctx.domain_error = Some(msg);
+            ffi::SNESSetFunctionDomainError(snes)
+        }
+        Ok(Err(e)) => {
+            ctx.error = Some(e);
+            ffi::PETSC_ERR_LIB as ffi::PetscErrorCode
+        }
+        Err(_) => {
+            ctx.error = Some(rust_error("panic in residual evaluation"));
+            ffi::PETSC_ERR_LIB as ffi::PetscErrorCode
+        }
+    }
+}
+
+unsafe extern "C" fn form_jacobian(_snes: ffi::SNES, x: ffi::Vec, j: ffi::Mat, _p: ffi::Mat, ctx: *mut c_void) -> ffi::PetscErrorCode {
+    let ctx = &mut *(ctx as *mut Context);
+    let run = || -> Result<()> {
+        let xv = std::mem::ManuallyDrop::new(Vector { raw: x });
+        let jm = std::mem::ManuallyDrop::new(Matrix { raw: j });
+        let all = xv.gather_all()?;
+        ctx.problem.jacobian(&all, &jm)?;
+        jm.assemble()
+    };
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+        Ok(Ok(())) => 0,
+        Ok(Err(e)) => {
+            ctx.error = Some(e);
+            ffi::PETSC_ERR_LIB as ffi::PetscErrorCode
+        }
+        Err(_) => {
+            ctx.error = Some(rust_error("panic in Jacobian evaluation"));
+            ffi::PETSC_ERR_LIB as ffi::PetscErrorCode
+        }
+    }
+}
+
+impl Snes {
+    /// A SNES configured from the options database (with `prefix`, e.g. "" or "ehl_").
+    pub fn new(comm: ffi::MPI_Comm, prefix: &str) -> Result<Snes> {
+        let mut raw: ffi::SNES = std::ptr::null_mut();
+        pcall!(ffi::SNESCreate(comm, &mut raw))?;
+        let s = Snes { raw };
+        if !prefix.is_empty() {
+            let p = std::ffi::CString::new(prefix).unwrap();
+            pcall!(ffi::SNESSetOptionsPrefix(s.raw, p.as_ptr()))?;
+        }
+        Ok(s)
+    }
+
+    /// Solves F(x) = 0 from the initial guess in `x`, with Jacobian storage `j`.
+    /// Options are read here (so defaults set before this call apply).
+    pub fn solve(&self, problem: &mut dyn Problem, x: &Vector, j: &Matrix) -> Result<SolveReport> {
+        let r = x.duplicate()?;
+        let mut ctx = Context { problem, domain_error: None, error: None };
+        let ctxp = &mut ctx as *mut Context as *mut c_void;
+        pcall!(ffi::SNESSetFunction(self.raw, r.raw, Some(form_function), ctxp))?;
+        pcall!(ffi::SNESSetJacobian(self.raw, j.raw, j.raw, Some(form_jacobian), ctxp))?;
+        pcall!(ffi::SNESSetFromOptions(self.raw))?;
+        let code = unsafe { ffi::SNESSolve(self.raw, std::ptr::null_mut(), x.raw) };
+        // Detach the callbacks' context before it goes out of scope.
+        let _ = unsafe { ffi::SNESSetFunction(self.raw, r.raw, None, std::ptr::null_mut()) };
+        if let Some(e) = ctx.error.take() {
+            let _ = check(code);
+            return Err(e);
+        }
+        check(code)?;
+        let mut reason: ffi::SNESConvergedReason = 0;
+        pcall!(ffi::SNESGetConvergedReason(self.raw, &mut reason))?;
+        let mut s: *const std::os::raw::c_char = std::ptr::null();
+        pcall!(ffi::SNESGetConvergedReasonString(self.raw, &mut s))?;
+        let reason_name = if s.is_null() { reason.to_string() } else { unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned() };
+        let (mut its, mut lits): (ffi::PetscInt, ffi::PetscInt) = (0, 0);
+        pcall!(ffi::SNESGetIterationNumber(self.raw, &mut its))?;
+        pcall!(ffi::SNESGetLinearSolveIterations(self.raw, &mut lits))?;
+        let mut norm = 0.0;
+        pcall!(ffi::SNESGetFunctionNorm(self.raw, &mut norm))?;
+        Ok(SolveReport {
+            converged: reason > 0,
+            reason: reason_name,
+            reason_code: reason,
+            iterations: its as usize,
+            linear_iterations: lits as usize,
+            residual_norm: norm,
+            domain_error: ctx.domain_error.take(),
+        })
+    }
+
+    /// Raw handle for FFI calls.
+    pub fn raw(&self) -> ffi::SNES {
+        self.raw
+    }
+}
+
+impl Drop for Snes {
+    fn drop(&mut self) {
+        unsafe { ffi::SNESDestroy(&mut self.raw) };
+    }
+}

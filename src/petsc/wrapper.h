@@ -1,0 +1,2 @@
+#include <petscsnes.h>
+#include <petscviewer.h>

@@ -1,0 +1,74 @@
+//! Helpers for integration tests: run the real binary, under mpirun, in a scratch folder.
+#![allow(dead_code)]
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The ehl-petsc binary cargo built for these tests.
+pub fn binary() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_ehl-petsc"))
+}
+
+/// The repository root (for cases/).
+pub fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A fresh empty scratch folder under target/test-scratch/<name>.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = repo().join("target").join("test-scratch").join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn mpi_env(cmd: &mut Command) {
+    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
+        .env("OPENBLAS_NUM_THREADS", "1")
+        .env("OMP_NUM_THREADS", "1");
+}
+
+/// Runs `mpirun -n ranks ehl-petsc args...` and returns its output.
+pub fn mpirun(ranks: usize, args: &[&str]) -> Output {
+    let mut cmd = Command::new("mpirun");
+    cmd.arg("-n").arg(ranks.to_string()).arg(binary()).args(args);
+    mpi_env(&mut cmd);
+    cmd.output().expect("mpirun could not be started (is openmpi-bin installed? run ci/setup)")
+}
+
+/// Runs the binary directly (MPI singleton), for command-line checks.
+pub fn run_plain(args: &[&str]) -> Output {
+    let mut cmd = Command::new(binary());
+    cmd.args(args);
+    mpi_env(&mut cmd);
+    cmd.output().expect("binary could not be started")
+}
+
+/// stdout + stderr as one string (for assertion messages).
+pub fn text(out: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+}
+
+/// Reads a summary.json.
+pub fn summary(dir: &Path) -> serde_json::Value {
+    let path = dir.join("summary.json");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
+/// Writes a scene file into `dir` and returns its path as a String.
+pub fn write_scene(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_string_lossy().into_owned()
+}
+
+/// A number from a JSON path like "elastic.u2_center_m".
+pub fn num(v: &serde_json::Value, path: &str) -> f64 {
+    let mut cur = v;
+    for key in path.split('.') {
+        cur = &cur[key];
+    }
+    cur.as_f64().unwrap_or_else(|| panic!("{path} is not a number in {v}"))
+}
