@@ -1,0 +1,326 @@
+//! Mesh specification: box geometry, contact rectangle, grading law, and
+//! validation of all of it (including the coarse tensor grid breakpoints).
+//!
+//! All lengths are dimensionless, in units of the Hertz radius `a`.
+
+/// Edge length of the coarse tensor-grid cells (units of `a`).
+pub const COARSE_CELL: f64 = 16.0;
+
+/// Maximum number of halvings of [`COARSE_CELL`] allowed for the contact size.
+pub const MAX_LEVEL: u32 = 20;
+
+/// Axis-aligned rectangle `[x0, x1] x [z0, z1]` on the top face `y = 0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rect {
+    pub x0: f64,
+    pub x1: f64,
+    pub z0: f64,
+    pub z1: f64,
+}
+
+impl Rect {
+    /// Area of the rectangle.
+    pub fn area(&self) -> f64 {
+        (self.x1 - self.x0) * (self.z1 - self.z0)
+    }
+
+    /// True if `(x, z)` lies in the rectangle enlarged by `tol` on each side.
+    pub fn contains(&self, x: f64, z: f64, tol: f64) -> bool {
+        x >= self.x0 - tol && x <= self.x1 + tol && z >= self.z0 - tol && z <= self.z1 + tol
+    }
+}
+
+/// Parameters of the graded tetrahedral mesh of the equivalent solid.
+///
+/// The box is `x in [-W/2, W/2]`, `y in [-D, 0]`, `z in [-W/2, z_hi]` with
+/// `W = cube_edge`, `D = depth`, `z_hi = 0` if `half_z` else `W/2`.
+/// The target element size at distance `d` from the contact rectangle is
+/// `h(d) = contact_size + growth * d`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshSpec {
+    pub cube_edge: f64,
+    pub depth: f64,
+    pub half_z: bool,
+    pub contact: Rect,
+    pub contact_size: f64,
+    pub growth: f64,
+}
+
+impl MeshSpec {
+    /// The paper's setup: 60 x 60 x 60 cube, contact `[-3,3]^2`, `h_c = 0.25`, growth 0.5.
+    pub fn paper_default() -> Self {
+        MeshSpec {
+            cube_edge: 60.0,
+            depth: 60.0,
+            half_z: false,
+            contact: Rect {
+                x0: -3.0,
+                x1: 3.0,
+                z0: -3.0,
+                z1: 3.0,
+            },
+            contact_size: 0.25,
+            growth: 0.5,
+        }
+    }
+
+    /// Box corners `(lo, hi)` as `[x, y, z]`.
+    ///
+    /// Full domain: `z in [-W/2, W/2]`. Half domain (`half_z`): `z in [-W/2, 0]`,
+    /// the symmetry plane `z = 0` being the upper z face.
+    pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
+        let w2 = 0.5 * self.cube_edge;
+        let z_hi = if self.half_z { 0.0 } else { w2 };
+        ([-w2, -self.depth, -w2], [w2, 0.0, z_hi])
+    }
+
+    /// Box volume.
+    pub fn box_volume(&self) -> f64 {
+        let (lo, hi) = self.bounds();
+        (0..3).map(|a| hi[a] - lo[a]).product()
+    }
+
+    /// Box surface area.
+    pub fn box_surface(&self) -> f64 {
+        let (lo, hi) = self.bounds();
+        let l: Vec<f64> = (0..3).map(|a| hi[a] - lo[a]).collect();
+        2.0 * (l[0] * l[1] + l[1] * l[2] + l[0] * l[2])
+    }
+
+    /// Actual contact size: the largest `16 / 2^L <= contact_size` (L >= 0).
+    pub fn actual_contact_size(&self) -> f64 {
+        let mut h = COARSE_CELL;
+        let mut level = 0;
+        while h > self.contact_size && level < MAX_LEVEL {
+            h *= 0.5;
+            level += 1;
+        }
+        h
+    }
+
+    /// Coarse grid breakpoints along the three axes.
+    pub fn coarse_grid(&self) -> [Vec<f64>; 3] {
+        let (lo, hi) = self.bounds();
+        [0, 1, 2].map(|a| coarse_breaks(lo[a], hi[a], COARSE_CELL))
+    }
+
+    /// Validates the spec; returns the actual contact size on success.
+    pub fn validate(&self) -> Result<f64, String> {
+        self.validate_scalars()?;
+        let h = self.actual_contact_size();
+        self.validate_rect(h)?;
+        Ok(h)
+    }
+
+    /// Checks positivity / finiteness of the scalar parameters.
+    fn validate_scalars(&self) -> Result<(), String> {
+        let pos = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!(
+                    "mesh spec: {name} must be finite and > 0 (got {v})"
+                ))
+            }
+        };
+        pos("cube_edge", self.cube_edge)?;
+        pos("depth", self.depth)?;
+        pos("contact_size", self.contact_size)?;
+        pos("growth", self.growth)?;
+        if self.contact_size < COARSE_CELL / f64::from(1u32 << MAX_LEVEL) {
+            return Err(format!(
+                "mesh spec: contact_size {} is below the minimum 16/2^{MAX_LEVEL}",
+                self.contact_size
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks that the contact rectangle is non-empty, inside the top face,
+    /// has edges on the dyadic grid of spacing `h`, and lies in full-size
+    /// (16 x 16 x 16) coarse cells so that the mesh over it is a uniform
+    /// Kuhn grid of spacing `h`.
+    fn validate_rect(&self, h: f64) -> Result<(), String> {
+        let r = self.contact;
+        let vals = [r.x0, r.x1, r.z0, r.z1];
+        if vals.iter().any(|v| !v.is_finite()) || r.x0 >= r.x1 || r.z0 >= r.z1 {
+            return Err(format!(
+                "mesh spec: contact rectangle {r:?} is empty or not finite"
+            ));
+        }
+        let (lo, hi) = self.bounds();
+        let tol = 1e-12 * self.cube_edge;
+        if r.x0 < lo[0] - tol || r.x1 > hi[0] + tol || r.z0 < lo[2] - tol || r.z1 > hi[2] + tol {
+            return Err(format!(
+                "mesh spec: contact rectangle {r:?} is not inside the top face \
+                 x in [{}, {}], z in [{}, {}]",
+                lo[0], hi[0], lo[2], hi[2]
+            ));
+        }
+        for v in vals {
+            if !on_dyadic_grid(v, h) {
+                return Err(format!(
+                    "mesh spec: contact rectangle edge {v} is not a multiple of the actual \
+                     contact size {h} (requested {})",
+                    self.contact_size
+                ));
+            }
+        }
+        self.validate_full_cells(h)
+    }
+
+    /// Checks that all coarse cells under the rectangle are full 16-cubes.
+    fn validate_full_cells(&self, _h: f64) -> Result<(), String> {
+        let r = self.contact;
+        let g = self.coarse_grid();
+        let top = g[1][g[1].len() - 2..].to_vec();
+        if (top[1] - top[0] - COARSE_CELL).abs() > 1e-12 {
+            return Err(format!(
+                "mesh spec: depth {} too small: the top coarse layer must be {COARSE_CELL} thick \
+                 (need depth >= {})",
+                self.depth,
+                1.5 * COARSE_CELL
+            ));
+        }
+        for (axis, (a, b)) in [(0usize, (r.x0, r.x1)), (2, (r.z0, r.z1))] {
+            for w in g[axis].windows(2) {
+                let overlaps = w[1] > a && w[0] < b;
+                if overlaps && (w[1] - w[0] - COARSE_CELL).abs() > 1e-12 {
+                    return Err(format!(
+                        "mesh spec: contact rectangle {r:?} overlaps the coarse cell [{}, {}] \
+                         along axis {} which is not a full {COARSE_CELL}-cell; enlarge the box",
+                        w[0],
+                        w[1],
+                        ["x", "y", "z"][axis]
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// True if `v` is an integer multiple of `h` (up to round-off).
+fn on_dyadic_grid(v: f64, h: f64) -> bool {
+    let q = v / h;
+    (q - q.round()).abs() < 1e-9
+}
+
+/// Coarse breakpoints of `[lo, hi]`: `lo`, the multiples of `c` strictly
+/// inside, `hi`; an end interval shorter than `c/2` is merged with its
+/// neighbour (when there is one).
+pub fn coarse_breaks(lo: f64, hi: f64, c: f64) -> Vec<f64> {
+    let mut b = vec![lo];
+    let mut k = (lo / c).floor() as i64 + 1;
+    while (k as f64) * c < hi {
+        let v = (k as f64) * c;
+        if v > lo {
+            b.push(v);
+        }
+        k += 1;
+    }
+    b.push(hi);
+    if b.len() > 2 && b[1] - b[0] < 0.5 * c {
+        b.remove(1);
+    }
+    let n = b.len();
+    if n > 2 && b[n - 1] - b[n - 2] < 0.5 * c {
+        b.remove(n - 2);
+    }
+    b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn breaks_match_examples() {
+        assert_eq!(
+            coarse_breaks(-30.0, 30.0, 16.0),
+            vec![-30.0, -16.0, 0.0, 16.0, 30.0]
+        );
+        assert_eq!(
+            coarse_breaks(-60.0, 0.0, 16.0),
+            vec![-60.0, -48.0, -32.0, -16.0, 0.0]
+        );
+        assert_eq!(coarse_breaks(-30.0, 0.0, 16.0), vec![-30.0, -16.0, 0.0]);
+        // remainder 2 < 8 merged with its neighbour
+        assert_eq!(
+            coarse_breaks(-34.0, 34.0, 16.0),
+            vec![-34.0, -16.0, 0.0, 16.0, 34.0]
+        );
+        assert_eq!(coarse_breaks(-20.0, 0.0, 16.0), vec![-20.0, 0.0]);
+    }
+
+    #[test]
+    fn actual_size_is_dyadic_floor() {
+        let mut s = MeshSpec::paper_default();
+        assert_eq!(s.actual_contact_size(), 0.25);
+        s.contact_size = 0.3;
+        assert_eq!(s.actual_contact_size(), 0.25);
+        s.contact_size = 100.0;
+        assert_eq!(s.actual_contact_size(), 16.0);
+        s.contact_size = 0.0625;
+        assert_eq!(s.actual_contact_size(), 0.0625);
+    }
+
+    #[test]
+    fn half_domain_bounds() {
+        let mut s = MeshSpec::paper_default();
+        s.half_z = true;
+        let (lo, hi) = s.bounds();
+        assert_eq!(lo, [-30.0, -60.0, -30.0]);
+        assert_eq!(hi, [30.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn validation_accepts_paper_cases() {
+        let mut s = MeshSpec::paper_default();
+        assert_eq!(s.validate(), Ok(0.25));
+        s.contact = Rect {
+            x0: -4.5,
+            x1: 1.5,
+            z0: -3.0,
+            z1: 3.0,
+        };
+        assert!(s.validate().is_ok());
+        s.half_z = true;
+        s.contact = Rect {
+            x0: -3.0,
+            x1: 3.0,
+            z0: -3.0,
+            z1: 0.0,
+        };
+        assert!(s.validate().is_ok());
+    }
+
+    #[test]
+    fn validation_rejects_bad_specs() {
+        let base = MeshSpec::paper_default();
+        let mut s = base.clone();
+        s.growth = 0.0;
+        assert!(s.validate().unwrap_err().contains("growth"));
+        let mut s = base.clone();
+        s.contact_size = -1.0;
+        assert!(s.validate().unwrap_err().contains("contact_size"));
+        let mut s = base.clone();
+        s.contact.x0 = -3.1;
+        assert!(s.validate().unwrap_err().contains("multiple"));
+        let mut s = base.clone();
+        s.contact.x1 = 40.0;
+        assert!(s.validate().unwrap_err().contains("inside"));
+        let mut s = base.clone();
+        s.contact.x1 = 20.0;
+        assert!(s.validate().unwrap_err().contains("full"));
+        let mut s = base.clone();
+        s.depth = 20.0;
+        assert!(s.validate().unwrap_err().contains("depth"));
+        let mut s = base.clone();
+        s.half_z = true; // R = [-3,3]^2 sticks out of z in [-30, 0]
+        assert!(s.validate().unwrap_err().contains("inside"));
+        let mut s = base;
+        s.contact.x0 = 3.0;
+        assert!(s.validate().unwrap_err().contains("empty"));
+    }
+}
