@@ -33,7 +33,7 @@ pub fn contact_uy(mesh: &Mesh, dofs: &DofMap, sol: &[f64], x: f64, z: f64) -> Re
         let d = dofs.node_dof[n as usize][1];
         if d < 0 { 0.0 } else { sol[d as usize] }
     });
-    Ok(crate::fem::p2tri::eval(&vals, &bary))
+    Ok(crate::fem::p2_tri_eval(&vals, bary))
 }
 
 pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {

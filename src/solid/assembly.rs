@@ -27,13 +27,14 @@ pub fn assemble_stiffness(comm: ffi::MPI_Comm, mesh: &Mesh, part: &Partition, do
     let (d_nnz, o_nnz) = preallocation(mesh, part, dofs, rank);
     let a = Matrix::new_aij(comm, dofs.local(rank), &d_nnz, &o_nnz)?;
     let (lambda, mu) = fem::elasticity::lame(1.0, nu);
+    let mut ke = [0.0; 900];
     for (k, tet) in mesh.tets.iter().enumerate() {
         if part.tet_rank[k] as usize != rank {
             continue;
         }
-        let ke = fem::elasticity::elasticity_stiffness(&tet_vertices(mesh, tet), lambda, mu);
+        fem::elasticity::elasticity_stiffness_flat(&tet_vertices(mesh, tet), lambda, mu, &mut ke);
         let idx = dofs.tet_dofs(tet);
-        a.add_values(&idx, &idx, ke.as_flattened())?;
+        a.add_values(&idx, &idx, &ke)?;
     }
     a.assemble()?;
     a.set_symmetric(true)?;

@@ -65,16 +65,16 @@ fn accumulate(v: &[[f64; 2]; 3], sub: &[[f64; 3]; 3], depth: u32, out: &mut [f64
     let det = |a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]| (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]);
     let rel = det(&sub[0], &sub[1], &sub[2]).abs();
     let area = 0.5 * ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1])).abs();
-    for q in fem::quadrature::TRI_DEG5.iter() {
-        // q.point: barycentric-like reference (s, t); map to the sub-triangle.
-        let (s, t, w) = (q[0], q[1], q[2]);
+    for (xi, w) in fem::tri_rule(5).iter() {
+        // Reference point (s, t) mapped to the sub-triangle; weights sum to 1/2.
+        let (s, t) = (xi[0], xi[1]);
         let b = [0, 1, 2].map(|k| (1.0 - s - t) * sub[0][k] + s * sub[1][k] + t * sub[2][k]);
         let xy = to_xy(v, &b);
         let p = hertz_pressure(xy[0], xy[1]);
         if p == 0.0 {
             continue;
         }
-        let n = fem::p2tri::basis_bary(&b);
+        let n = fem::p2tri::p2_tri_basis_bary(b);
         for i in 0..6 {
             out[i] += w * 2.0 * area * rel * p * n[i];
         }
