@@ -14,3 +14,4 @@ pub mod mesh;
 pub mod output;
 pub mod petsc;
 pub mod physics;
+pub mod reynolds;
