@@ -10,9 +10,11 @@
 //! - [`output`]: summary.json and other result files.
 pub mod app;
 pub mod case;
+pub mod ehl;
 pub mod fem;
 pub mod mesh;
 pub mod output;
 pub mod petsc;
 pub mod physics;
 pub mod solid;
+pub mod reynolds;

@@ -1,0 +1,257 @@
+//! Element residual and exact Jacobian of the dimensionless Reynolds equation on one
+//! straight P2 triangle. See the module documentation of [`crate::reynolds`] for the
+//! formulas.
+
+use super::dual::Dual;
+use super::p2::P2Triangle;
+use super::quadrature::DUNAVANT6;
+
+/// Number of element unknowns differentiated: 6 nodal P then 6 nodal H.
+pub const NDOF: usize = 12;
+
+/// Dual number over the 12 element unknowns (P_0..P_5, H_0..H_5).
+pub type D12 = Dual<NDOF>;
+
+/// Lubricant laws in dimensionless form, all functions of the dimensionless pressure P.
+///
+/// `eta(P) = (eta_bar, d eta_bar/dP)`, `rho(P) = (rho_bar, d rho_bar/dP)`.
+/// `d2eta`, `d2rho` give the second derivatives d^2 eta_bar/dP^2 and d^2 rho_bar/dP^2:
+/// the SUPG strong residual contains grad eps = eps_P grad P + eps_H grad H, and the
+/// exact Jacobian of eps_P needs them. They are not evaluated when SUPG is off.
+pub struct Fluid<'a> {
+    /// eta_bar(P) and d eta_bar/dP.
+    pub eta: &'a dyn Fn(f64) -> (f64, f64),
+    /// rho_bar(P) and d rho_bar/dP.
+    pub rho: &'a dyn Fn(f64) -> (f64, f64),
+    /// d^2 eta_bar/dP^2.
+    pub d2eta: &'a dyn Fn(f64) -> f64,
+    /// d^2 rho_bar/dP^2.
+    pub d2rho: &'a dyn Fn(f64) -> f64,
+    /// lambda_bar = 12 eta_R Ue R^2 / (a^3 p_H).
+    pub lambda_bar: f64,
+}
+
+fn unit_law(_: f64) -> (f64, f64) {
+    (1.0, 0.0)
+}
+fn zero_law(_: f64) -> f64 {
+    0.0
+}
+
+impl Fluid<'static> {
+    /// Incompressible, iso-viscous lubricant: eta_bar = rho_bar = 1.
+    pub fn constant(lambda_bar: f64) -> Self {
+        Fluid {
+            eta: &unit_law,
+            rho: &unit_law,
+            d2eta: &zero_law,
+            d2rho: &zero_law,
+            lambda_bar,
+        }
+    }
+}
+
+/// Streamline-upwind Petrov-Galerkin (SUPG) stabilisation settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stabilisation {
+    /// Add the SUPG term.
+    pub supg: bool,
+    /// Multiplier delta of the stabilisation parameter tau (1.0 by default).
+    pub delta: f64,
+}
+
+impl Default for Stabilisation {
+    /// SUPG on, delta = 1.
+    fn default() -> Self {
+        Self {
+            supg: true,
+            delta: 1.0,
+        }
+    }
+}
+
+impl Stabilisation {
+    /// Plain Galerkin.
+    pub fn none() -> Self {
+        Self {
+            supg: false,
+            delta: 1.0,
+        }
+    }
+    /// SUPG with multiplier `delta`.
+    pub fn supg(delta: f64) -> Self {
+        Self { supg: true, delta }
+    }
+}
+
+/// Element residual and its exact Jacobian.
+#[derive(Clone, Debug)]
+pub struct ElementOut {
+    /// R_i, i = local node.
+    pub r: [f64; 6],
+    /// dR_i/dP_j.
+    pub dr_dp: [[f64; 6]; 6],
+    /// dR_i/dH_j.
+    pub dr_dh: [[f64; 6]; 6],
+}
+
+/// Upwind function xi(Pe) = coth(Pe) - 1/Pe and its derivative.
+/// xi ~ Pe/3 for small Pe (series below Pe = 1e-2, avoiding cancellation), xi -> 1 for large Pe.
+pub fn xi(pe: f64) -> (f64, f64) {
+    if pe < 1e-2 {
+        let p2 = pe * pe;
+        (
+            pe * (1.0 / 3.0 - p2 / 45.0 + 2.0 * p2 * p2 / 945.0),
+            1.0 / 3.0 - p2 / 15.0 + 2.0 * p2 * p2 / 189.0,
+        )
+    } else {
+        let s = pe.sinh(); // inf for pe > ~710: 1/s^2 = 0, fine
+        (1.0 / pe.tanh() - 1.0 / pe, 1.0 / (pe * pe) - 1.0 / (s * s))
+    }
+}
+
+/// Length of the triangle in the direction of `v` (Tezduyar's h_UGN):
+/// h_s = 2 |v| / sum_k |v . grad L_k|. Returns 0 for v = 0.
+pub fn streamline_length(tri: &P2Triangle, v: [f64; 2]) -> f64 {
+    let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
+    if vn == 0.0 {
+        return 0.0;
+    }
+    let s: f64 = tri
+        .grad_l
+        .iter()
+        .map(|g| (v[0] * g[0] + v[1] * g[1]).abs())
+        .sum();
+    2.0 * vn / s
+}
+
+/// Element residual and exact Jacobian of the Reynolds equation (no source term).
+///
+/// `verts`: the 3 vertices; `p`, `h`: nodal P and H (order v0, v1, v2, m01, m12, m20);
+/// `vel`: entrainment velocity (u_bar, w_bar) at the 3 vertices (affine inside).
+/// The film H should be positive (eps ~ H^3; nothing here clips it) and eta_bar, rho_bar
+/// nonzero. Any vertex orientation is accepted.
+pub fn reynolds_element(
+    verts: &[[f64; 2]; 3],
+    p: &[f64; 6],
+    h: &[f64; 6],
+    vel: &[[f64; 2]; 3],
+    fluid: &Fluid,
+    stab: &Stabilisation,
+) -> ElementOut {
+    reynolds_element_with_source(verts, p, h, vel, fluid, stab, None)
+}
+
+/// As [`reynolds_element`], for the equation with a right-hand side f(X, Z):
+/// -div(eps grad P) + div(rho_bar H vel) = f. The source enters the Galerkin part as
+/// -int f N_i and the SUPG strong residual as r_strong - f (so SUPG stays consistent).
+/// Used for manufactured solutions; the physical problem has f = 0.
+pub fn reynolds_element_with_source(
+    verts: &[[f64; 2]; 3],
+    p: &[f64; 6],
+    h: &[f64; 6],
+    vel: &[[f64; 2]; 3],
+    fluid: &Fluid,
+    stab: &Stabilisation,
+    source: Option<&dyn Fn(f64, f64) -> f64>,
+) -> ElementOut {
+    let tri = P2Triangle::new(verts);
+    let pd: [D12; 6] = std::array::from_fn(|j| D12::variable(p[j], j));
+    let hd: [D12; 6] = std::array::from_fn(|j| D12::variable(h[j], 6 + j));
+
+    // P2 second derivatives are constant: Lap P, Lap H once per element.
+    // (Lap H does not enter the residual.)
+    let mut lap_p = D12::constant(0.0);
+    for j in 0..6 {
+        lap_p += pd[j] * tri.lap[j];
+    }
+    // div vel (zero for rigid-body entrainment; kept so the strong residual is exact
+    // for any affine field): div v = sum_k v_k . grad L_k
+    let div_v: f64 = (0..3)
+        .map(|k| vel[k][0] * tri.grad_l[k][0] + vel[k][1] * tri.grad_l[k][1])
+        .sum();
+
+    let mut res = [D12::constant(0.0); 6];
+    for q in DUNAVANT6.iter() {
+        let l = &q.l;
+        let wq = q.w * tri.area;
+        let n = P2Triangle::shape(l);
+        let dn = tri.grad(l);
+
+        let mut pq = D12::constant(0.0);
+        let mut hq = D12::constant(0.0);
+        let mut gp = [D12::constant(0.0); 2];
+        let mut gh = [D12::constant(0.0); 2];
+        for j in 0..6 {
+            pq += pd[j] * n[j];
+            hq += hd[j] * n[j];
+            for c in 0..2 {
+                gp[c] += pd[j] * dn[j][c];
+                gh[c] += hd[j] * dn[j][c];
+            }
+        }
+        let v = [
+            l[0] * vel[0][0] + l[1] * vel[1][0] + l[2] * vel[2][0],
+            l[0] * vel[0][1] + l[1] * vel[1][1] + l[2] * vel[2][1],
+        ];
+        let x = tri.point(l);
+        let f = source.map_or(0.0, |s| s(x[0], x[1]));
+
+        let (eta, deta) = (fluid.eta)(pq.v);
+        let (rho, drho) = (fluid.rho)(pq.v);
+        let eta_d = pq.chain(eta, deta);
+        let rho_d = pq.chain(rho, drho);
+        let h3 = hq * hq * hq;
+        let eps = rho_d * h3 / (eta_d * fluid.lambda_bar);
+        let rho_h = rho_d * hq;
+
+        // Galerkin: eps grad P . grad N_i - rho H (v . grad N_i) - f N_i
+        let v_dn: [f64; 6] = std::array::from_fn(|i| v[0] * dn[i][0] + v[1] * dn[i][1]);
+        for i in 0..6 {
+            let flux = gp[0] * dn[i][0] + gp[1] * dn[i][1];
+            res[i] += (eps * flux - rho_h * v_dn[i] - f * n[i]) * wq;
+        }
+
+        if stab.supg {
+            let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
+            if vn == 0.0 {
+                continue; // the SUPG weight v . grad N_i vanishes
+            }
+            // eps_P = eps (rho'/rho - eta'/eta), eps_H = 3 eps / H, as duals (needs rho'', eta'')
+            let deta_d = pq.chain(deta, (fluid.d2eta)(pq.v));
+            let drho_d = pq.chain(drho, (fluid.d2rho)(pq.v));
+            let eps_p = eps * (drho_d / rho_d - deta_d / eta_d);
+            let eps_h = rho_d * hq * hq * 3.0 / (eta_d * fluid.lambda_bar); // 3 eps / H, no division by H
+            let g_eps = [eps_p * gp[0] + eps_h * gh[0], eps_p * gp[1] + eps_h * gh[1]];
+            let div_flux = eps * lap_p + g_eps[0] * gp[0] + g_eps[1] * gp[1];
+            // div(rho H v) = v . grad(rho H) + rho H div v, grad(rho H) = rho' H grad P + rho grad H
+            let drho_h = drho_d * hq;
+            let conv = (drho_h * gp[0] + rho_d * gh[0]) * v[0]
+                + (drho_h * gp[1] + rho_d * gh[1]) * v[1]
+                + rho_h * div_v;
+            let r_strong = conv - div_flux - f;
+
+            // tau = delta h_e / (2|v|) xi(Pe), Pe = |v| h_e / (2 eps), h_e = streamline length
+            let h_e = streamline_length(&tri, v);
+            let pe = (vn * h_e * 0.5) / eps;
+            let (xv, dxv) = xi(pe.v);
+            let tau = pe.chain(xv, dxv) * (stab.delta * h_e / (2.0 * vn));
+            let t_r = tau * r_strong * wq;
+            for i in 0..6 {
+                res[i] += t_r * v_dn[i];
+            }
+        }
+    }
+
+    let mut out = ElementOut {
+        r: [0.0; 6],
+        dr_dp: [[0.0; 6]; 6],
+        dr_dh: [[0.0; 6]; 6],
+    };
+    for i in 0..6 {
+        out.r[i] = res[i].v;
+        out.dr_dp[i].copy_from_slice(&res[i].d[..6]);
+        out.dr_dh[i].copy_from_slice(&res[i].d[6..]);
+    }
+    out
+}

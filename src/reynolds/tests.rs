@@ -1,0 +1,604 @@
+//! Tests of the Reynolds element: exact Jacobian, consistency, manufactured-solution
+//! convergence, and what SUPG does on an advection-dominated problem.
+
+use super::element::*;
+use super::p2::P2Triangle;
+use super::quadrature::DUNAVANT6;
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::PI;
+
+// ---------------------------------------------------------------- lubricant laws
+
+/// Exponential (Barus/Roelands-like) law eta_bar = exp(19 P).
+fn eta_exp19(p: f64) -> (f64, f64) {
+    let e = (19.0 * p).exp();
+    (e, 19.0 * e)
+}
+fn d2eta_exp19(p: f64) -> f64 {
+    361.0 * (19.0 * p).exp()
+}
+
+const P_H: f64 = 0.845e9;
+/// Dowson-Higginson in P units: rho_bar = (5.9e8 + 1.34 p)/(5.9e8 + p), p = P p_H.
+fn rho_dh(p: f64) -> (f64, f64) {
+    let q = 5.9e8 + P_H * p;
+    ((5.9e8 + 1.34 * P_H * p) / q, P_H * 0.34 * 5.9e8 / (q * q))
+}
+fn d2rho_dh(p: f64) -> f64 {
+    let q = 5.9e8 + P_H * p;
+    -2.0 * P_H * P_H * 0.34 * 5.9e8 / (q * q * q)
+}
+
+fn fluid_exp_dh(lambda_bar: f64) -> Fluid<'static> {
+    Fluid {
+        eta: &eta_exp19,
+        rho: &rho_dh,
+        d2eta: &d2eta_exp19,
+        d2rho: &d2rho_dh,
+        lambda_bar,
+    }
+}
+
+// ---------------------------------------------------------------- helpers
+
+/// Tiny deterministic generator (no external crate): uniform in [0, 1).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.next()
+    }
+}
+
+/// Rigid-body entrainment field (u0 - om z, w0 + om x) at the vertices (divergence-free).
+fn rigid_vel(verts: &[[f64; 2]; 3], u0: f64, w0: f64, om: f64) -> [[f64; 2]; 3] {
+    std::array::from_fn(|k| [u0 - om * verts[k][1], w0 + om * verts[k][0]])
+}
+
+/// Central finite-difference Jacobian, compared entry by entry with the exact one.
+/// Returns the largest row-relative error max_j |J_ij - Jfd_ij| / max_j |J_ij|.
+fn fd_jacobian_error(
+    verts: &[[f64; 2]; 3],
+    p: &[f64; 6],
+    h: &[f64; 6],
+    vel: &[[f64; 2]; 3],
+    fluid: &Fluid,
+    stab: &Stabilisation,
+) -> f64 {
+    let out = reynolds_element(verts, p, h, vel, fluid, stab);
+    let mut fd = [[0.0; 12]; 6];
+    for j in 0..12 {
+        let (mut pp, mut hp) = (*p, *h);
+        let (mut pm, mut hm) = (*p, *h);
+        let step = 1e-6;
+        if j < 6 {
+            pp[j] += step;
+            pm[j] -= step;
+        } else {
+            hp[j - 6] += step;
+            hm[j - 6] -= step;
+        }
+        let rp = reynolds_element(verts, &pp, &hp, vel, fluid, stab).r;
+        let rm = reynolds_element(verts, &pm, &hm, vel, fluid, stab).r;
+        for i in 0..6 {
+            fd[i][j] = (rp[i] - rm[i]) / (2.0 * step);
+        }
+    }
+    let mut worst: f64 = 0.0;
+    for i in 0..6 {
+        let exact: Vec<f64> = out.dr_dp[i]
+            .iter()
+            .chain(out.dr_dh[i].iter())
+            .copied()
+            .collect();
+        let scale = exact.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(scale > 0.0);
+        for j in 0..12 {
+            worst = worst.max((exact[j] - fd[i][j]).abs() / scale);
+        }
+    }
+    worst
+}
+
+// ---------------------------------------------------------------- Jacobian
+
+fn jacobian_check(stab: Stabilisation) {
+    let mut rng = Lcg(12345);
+    let fluid = fluid_exp_dh(0.3);
+    let mut worst: f64 = 0.0;
+    for trial in 0..20 {
+        // random, not too distorted triangle of size ~0.1..0.5
+        let s = rng.range(0.1, 0.5);
+        let c = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
+        let verts = [
+            [c[0], c[1]],
+            [
+                c[0] + s * rng.range(0.7, 1.3),
+                c[1] + s * rng.range(-0.3, 0.3),
+            ],
+            [
+                c[0] + s * rng.range(-0.3, 0.5),
+                c[1] + s * rng.range(0.7, 1.3),
+            ],
+        ];
+        let p: [f64; 6] = std::array::from_fn(|_| rng.range(0.0, 0.8));
+        let h: [f64; 6] = std::array::from_fn(|_| rng.range(0.3, 1.5));
+        let vel = if trial % 2 == 0 {
+            rigid_vel(
+                &verts,
+                rng.range(0.2, 1.0),
+                rng.range(-0.5, 0.5),
+                rng.range(-2.0, 2.0),
+            )
+        } else {
+            // general affine field (not divergence-free): the Jacobian must still be exact
+            std::array::from_fn(|_| [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)])
+        };
+        let e = fd_jacobian_error(&verts, &p, &h, &vel, &fluid, &stab);
+        worst = worst.max(e);
+    }
+    println!(
+        "supg = {}: worst row-relative Jacobian error vs central FD = {worst:.2e}",
+        stab.supg
+    );
+    assert!(worst < 1e-6, "Jacobian error {worst}");
+}
+
+#[test]
+fn jacobian_matches_finite_differences_galerkin() {
+    jacobian_check(Stabilisation::none());
+}
+
+#[test]
+fn jacobian_matches_finite_differences_supg() {
+    jacobian_check(Stabilisation::supg(1.0));
+}
+
+#[test]
+fn jacobian_matches_finite_differences_supg_diffusive_regime() {
+    // large lambda_bar^-1 (small Pe) exercises the series branch of xi(Pe)
+    let fluid = fluid_exp_dh(1e-4);
+    let verts = [[0.0, 0.0], [0.2, 0.02], [0.05, 0.18]];
+    let p = [0.1, 0.2, 0.05, 0.15, 0.12, 0.08];
+    let h = [1.0, 1.1, 0.9, 1.05, 1.0, 0.95];
+    let vel = rigid_vel(&verts, 1.0, 0.1, 0.5);
+    let e = fd_jacobian_error(&verts, &p, &h, &vel, &fluid, &Stabilisation::supg(1.0));
+    assert!(e < 1e-6, "{e}");
+}
+
+#[test]
+fn xi_branches_agree_and_limits() {
+    // series and closed form agree at the switch, derivative matches FD
+    let (a, da) = xi(1e-2 - 1e-12);
+    let (b, db) = xi(1e-2 + 1e-12);
+    assert!(
+        (b - a - da * 2e-12).abs() < 1e-13 && (da - db).abs() < 1e-9,
+        "{a} {b} {da} {db}"
+    );
+    for pe in [1e-3, 0.05, 0.7, 3.0, 30.0] {
+        let (_, d) = xi(pe);
+        let fd = (xi(pe * (1.0 + 1e-6)).0 - xi(pe * (1.0 - 1e-6)).0) / (2e-6 * pe);
+        assert!(
+            (d - fd).abs() < 1e-7 * (1.0 + d.abs()),
+            "pe {pe}: {d} vs {fd}"
+        );
+    }
+    assert!((xi(1e-5).0 - 1e-5 / 3.0).abs() < 1e-15);
+    assert_eq!(xi(1e4).0, 1.0 - 1e-4);
+    assert!(xi(1e4).1 > 0.0 && xi(800.0).1.is_finite());
+}
+
+// ---------------------------------------------------------------- consistency
+
+#[test]
+fn constant_fields_give_the_couette_term_only() {
+    // Triangle (0,0), (2,0), (0,1): area 1, grad L = (-1/2,-1), (1/2,0), (0,1).
+    // int grad N_vertex k = A/3 grad L_k; int grad N_mid(a,b) = -4A/3 grad L_c (c the third).
+    // With v = (1, 1/2): v.grad L = (-1, 1/2, 1/2), so
+    // R = -rho H (v . int grad N) = -rho H [-1/3, 1/6, 1/6, -2/3, 4/3, -2/3].
+    let verts = [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]];
+    let vel = [[1.0, 0.5]; 3];
+    let fluid = fluid_exp_dh(0.5);
+    let pc = 0.4;
+    let hc = 0.7;
+    let rho_h = rho_dh(pc).0 * hc;
+    let expect = [
+        -1.0 / 3.0,
+        1.0 / 6.0,
+        1.0 / 6.0,
+        -2.0 / 3.0,
+        4.0 / 3.0,
+        -2.0 / 3.0,
+    ]
+    .map(|x| -rho_h * x);
+    for stab in [Stabilisation::none(), Stabilisation::supg(1.0)] {
+        let out = reynolds_element(&verts, &[pc; 6], &[hc; 6], &vel, &fluid, &stab);
+        for i in 0..6 {
+            assert!(
+                (out.r[i] - expect[i]).abs() < 1e-13,
+                "{stab:?} node {i}: {} vs {}",
+                out.r[i],
+                expect[i]
+            );
+        }
+    }
+}
+
+#[test]
+fn linear_pressure_gives_the_exact_flux() {
+    // P = 0.3 + 1.2 X - 0.8 Z, H constant, constant laws: eps constant, r_strong = 0,
+    // R_i = (eps grad P - rho H v) . int grad N_i exactly, with or without SUPG.
+    let verts = [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]];
+    let g = [1.2, -0.8];
+    let tri = P2Triangle::new(&verts);
+    let p: [f64; 6] = tri.nodes().map(|x| 0.3 + g[0] * x[0] + g[1] * x[1]);
+    let hc = 1.3;
+    let lambda = 2.0;
+    let eps = hc * hc * hc / lambda;
+    let v = [1.0, 0.5];
+    let fl = [eps * g[0] - hc * v[0], eps * g[1] - hc * v[1]];
+    // int grad N_i from the hand values above
+    let gl = [[-0.5, -1.0], [0.5, 0.0], [0.0, 1.0]];
+    let int_grad: [[f64; 2]; 6] = [
+        gl[0].map(|x| x / 3.0),
+        gl[1].map(|x| x / 3.0),
+        gl[2].map(|x| x / 3.0),
+        gl[2].map(|x| -4.0 * x / 3.0),
+        gl[0].map(|x| -4.0 * x / 3.0),
+        gl[1].map(|x| -4.0 * x / 3.0),
+    ];
+    for stab in [Stabilisation::none(), Stabilisation::supg(1.0)] {
+        let out = reynolds_element(
+            &verts,
+            &p,
+            &[hc; 6],
+            &[v; 3],
+            &Fluid::constant(lambda),
+            &stab,
+        );
+        for i in 0..6 {
+            let e = fl[0] * int_grad[i][0] + fl[1] * int_grad[i][1];
+            assert!(
+                (out.r[i] - e).abs() < 1e-13,
+                "node {i}: {} vs {e}",
+                out.r[i]
+            );
+        }
+    }
+}
+
+// ---------------------------------------------------------------- a tiny mesh + solver
+
+/// Structured P2 mesh of [lo, hi]^2, n squares per side, each cut along its diagonal.
+struct Mesh {
+    nodes: Vec<[f64; 2]>,
+    tris: Vec<[usize; 6]>,
+    boundary: Vec<bool>,
+}
+
+fn square_mesh(n: usize, lo: f64, hi: f64) -> Mesh {
+    let m = 2 * n + 1;
+    let id = |i: usize, j: usize| j * m + i;
+    let step = (hi - lo) / (2 * n) as f64;
+    let mut nodes = Vec::new();
+    let mut boundary = Vec::new();
+    for j in 0..m {
+        for i in 0..m {
+            nodes.push([lo + i as f64 * step, lo + j as f64 * step]);
+            boundary.push(i == 0 || j == 0 || i == m - 1 || j == m - 1);
+        }
+    }
+    let mut tris = Vec::new();
+    for b in 0..n {
+        for a in 0..n {
+            let (i, j) = (2 * a, 2 * b);
+            // (i,j) -> (i+2,j) -> (i+2,j+2) and (i,j) -> (i+2,j+2) -> (i,j+2)
+            tris.push([
+                id(i, j),
+                id(i + 2, j),
+                id(i + 2, j + 2),
+                id(i + 1, j),
+                id(i + 2, j + 1),
+                id(i + 1, j + 1),
+            ]);
+            tris.push([
+                id(i, j),
+                id(i + 2, j + 2),
+                id(i, j + 2),
+                id(i + 1, j + 1),
+                id(i + 1, j + 2),
+                id(i, j + 1),
+            ]);
+        }
+    }
+    Mesh {
+        nodes,
+        tris,
+        boundary,
+    }
+}
+
+struct Problem<'a> {
+    mesh: &'a Mesh,
+    h: Vec<f64>,
+    vel: &'a dyn Fn(f64, f64) -> [f64; 2],
+    fluid: &'a Fluid<'a>,
+    stab: Stabilisation,
+    source: Option<&'a dyn Fn(f64, f64) -> f64>,
+}
+
+/// Newton's method with the exact Jacobian, P = 0 on the boundary, dense LU.
+/// Returns the nodal P and the number of Newton iterations.
+fn solve(pb: &Problem) -> (Vec<f64>, usize) {
+    let mesh = pb.mesh;
+    let mut dof = vec![usize::MAX; mesh.nodes.len()];
+    let mut ndof = 0;
+    for (k, &b) in mesh.boundary.iter().enumerate() {
+        if !b {
+            dof[k] = ndof;
+            ndof += 1;
+        }
+    }
+    let mut p = vec![0.0; mesh.nodes.len()];
+    for it in 1..=30 {
+        let mut r = DVector::<f64>::zeros(ndof);
+        let mut jac = DMatrix::<f64>::zeros(ndof, ndof);
+        for t in &mesh.tris {
+            let verts = [mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]];
+            let pe: [f64; 6] = t.map(|k| p[k]);
+            let he: [f64; 6] = t.map(|k| pb.h[k]);
+            let ve: [[f64; 2]; 3] = std::array::from_fn(|k| (pb.vel)(verts[k][0], verts[k][1]));
+            let out =
+                reynolds_element_with_source(&verts, &pe, &he, &ve, pb.fluid, &pb.stab, pb.source);
+            for i in 0..6 {
+                let gi = dof[t[i]];
+                if gi == usize::MAX {
+                    continue;
+                }
+                r[gi] += out.r[i];
+                for j in 0..6 {
+                    let gj = dof[t[j]];
+                    if gj != usize::MAX {
+                        jac[(gi, gj)] += out.dr_dp[i][j];
+                    }
+                }
+            }
+        }
+        let dp = jac.lu().solve(&(-r)).expect("singular Jacobian");
+        for (k, &g) in dof.iter().enumerate() {
+            if g != usize::MAX {
+                p[k] += dp[g];
+            }
+        }
+        let scale = p.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        if dp.amax() < 1e-12 * scale {
+            return (p, it);
+        }
+    }
+    panic!("Newton did not converge");
+}
+
+/// L2 norm of P_h - P_exact (degree-6 quadrature on each element).
+fn l2_error(mesh: &Mesh, p: &[f64], exact: &dyn Fn(f64, f64) -> f64) -> f64 {
+    let mut s = 0.0;
+    for t in &mesh.tris {
+        let tri = P2Triangle::new(&[mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]]);
+        for q in DUNAVANT6.iter() {
+            let n = P2Triangle::shape(&q.l);
+            let ph: f64 = (0..6).map(|i| n[i] * p[t[i]]).sum();
+            let x = tri.point(&q.l);
+            s += q.w * tri.area * (ph - exact(x[0], x[1])).powi(2);
+        }
+    }
+    s.sqrt()
+}
+
+// ---------------------------------------------------------------- manufactured solutions
+
+/// Manufactured P = sin(pi X) sin(pi Z) on [0,1]^2, H = 1 + (X^2 + Z^2)/2 (exactly P2).
+fn p_exact(x: f64, z: f64) -> f64 {
+    (PI * x).sin() * (PI * z).sin()
+}
+fn grad_p_exact(x: f64, z: f64) -> [f64; 2] {
+    [
+        PI * (PI * x).cos() * (PI * z).sin(),
+        PI * (PI * x).sin() * (PI * z).cos(),
+    ]
+}
+fn h_exact(x: f64, z: f64) -> f64 {
+    1.0 + 0.5 * (x * x + z * z)
+}
+
+/// f = -div(eps grad P) + div(rho H v) for the manufactured P, H and an affine,
+/// divergence-free v, written out independently of the element code:
+/// div(eps grad P) = eps Lap P + (eps_P grad P + eps_H grad H) . grad P,
+/// div(rho H v) = rho' H v . grad P + rho v . grad H.
+fn mms_source(fluid: &Fluid, vel: &dyn Fn(f64, f64) -> [f64; 2], x: f64, z: f64) -> f64 {
+    let p = p_exact(x, z);
+    let gp = grad_p_exact(x, z);
+    let lap_p = -2.0 * PI * PI * p;
+    let h = h_exact(x, z);
+    let gh = [x, z];
+    let (eta, deta) = (fluid.eta)(p);
+    let (rho, drho) = (fluid.rho)(p);
+    let eps = rho * h.powi(3) / (eta * fluid.lambda_bar);
+    let eps_p = eps * (drho / rho - deta / eta);
+    let eps_h = 3.0 * eps / h;
+    let div_flux = eps * lap_p
+        + (eps_p * gp[0] + eps_h * gh[0]) * gp[0]
+        + (eps_p * gp[1] + eps_h * gh[1]) * gp[1];
+    let v = vel(x, z);
+    let conv = drho * h * (v[0] * gp[0] + v[1] * gp[1]) + rho * (v[0] * gh[0] + v[1] * gh[1]);
+    -div_flux + conv
+}
+
+/// Solves the manufactured problem on n = 4, 8, 16 and returns the L2 errors.
+fn mms_errors(fluid: &Fluid, vel: &dyn Fn(f64, f64) -> [f64; 2], stab: Stabilisation) -> Vec<f64> {
+    let src = |x: f64, z: f64| mms_source(fluid, vel, x, z);
+    let mut errs = Vec::new();
+    for n in [4, 8, 16] {
+        let mesh = square_mesh(n, 0.0, 1.0);
+        let h = mesh.nodes.iter().map(|x| h_exact(x[0], x[1])).collect();
+        let pb = Problem {
+            mesh: &mesh,
+            h,
+            vel,
+            fluid,
+            stab,
+            source: Some(&src),
+        };
+        let (p, its) = solve(&pb);
+        let e = l2_error(&mesh, &p, &p_exact);
+        println!("  n = {n:2}: L2 error {e:.3e} ({its} Newton its)");
+        errs.push(e);
+    }
+    errs
+}
+
+fn orders(errs: &[f64]) -> Vec<f64> {
+    errs.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
+}
+
+#[test]
+fn manufactured_solution_converges_at_third_order_constant_laws() {
+    // eps = H^3 / 8 in [0.125, 1]; v = (1, 0)
+    let fluid = Fluid::constant(8.0);
+    let vel = |_: f64, _: f64| [1.0, 0.0];
+    for stab in [Stabilisation::none(), Stabilisation::supg(1.0)] {
+        println!("constant laws, {stab:?}");
+        let errs = mms_errors(&fluid, &vel, stab);
+        let o = orders(&errs);
+        println!("  observed orders {o:?}");
+        assert!(o[1] > 2.8 && o[1] < 3.3, "order {o:?}");
+        assert!(errs[2] < 2e-4);
+    }
+}
+
+#[test]
+fn manufactured_solution_converges_at_third_order_nonlinear_laws() {
+    // eta = exp(2 P), Dowson-Higginson rho, spinning entrainment field: Newton on the
+    // full nonlinear residual with the exact Jacobian.
+    fn eta2(p: f64) -> (f64, f64) {
+        let e = (2.0 * p).exp();
+        (e, 2.0 * e)
+    }
+    fn d2eta2(p: f64) -> f64 {
+        4.0 * (2.0 * p).exp()
+    }
+    let fluid = Fluid {
+        eta: &eta2,
+        rho: &rho_dh,
+        d2eta: &d2eta2,
+        d2rho: &d2rho_dh,
+        lambda_bar: 4.0,
+    };
+    let vel = |x: f64, z: f64| [1.0 + 0.3 * z, -0.3 * x];
+    for stab in [Stabilisation::none(), Stabilisation::supg(1.0)] {
+        println!("nonlinear laws, {stab:?}");
+        let errs = mms_errors(&fluid, &vel, stab);
+        let o = orders(&errs);
+        println!("  observed orders {o:?}");
+        assert!(o[1] > 2.8 && o[1] < 3.3, "order {o:?}");
+    }
+}
+
+// ---------------------------------------------------------------- what SUPG is for
+
+/// eta_bar = rho_bar = 1 + P makes eps = H^3/lambda constant while the Couette term
+/// div((1 + P) H v) = v . grad P (H = 1) advects P: the residual is that of the linear
+/// advection-diffusion problem -eps Lap P + v . grad P = 1, P = 0 on the boundary.
+fn one_plus_p(p: f64) -> (f64, f64) {
+    (1.0 + p, 1.0)
+}
+fn zero(_: f64) -> f64 {
+    0.0
+}
+
+/// Solves the boundary-layer problem (eps = 1e-6, v = (1, 0), f = 1, n = 16) and returns
+/// (min P over all nodes, max P over all nodes, P on the centre line Z = 1/2).
+fn boundary_layer(stab: Stabilisation) -> (f64, f64, Vec<f64>) {
+    let fluid = Fluid {
+        eta: &one_plus_p,
+        rho: &one_plus_p,
+        d2eta: &zero,
+        d2rho: &zero,
+        lambda_bar: 1e6,
+    };
+    let n = 16;
+    let mesh = square_mesh(n, 0.0, 1.0);
+    let vel = |_: f64, _: f64| [1.0, 0.0];
+    let one = |_: f64, _: f64| 1.0;
+    let pb = Problem {
+        mesh: &mesh,
+        h: vec![1.0; mesh.nodes.len()],
+        vel: &vel,
+        fluid: &fluid,
+        stab,
+        source: Some(&one),
+    };
+    let (p, _) = solve(&pb);
+    let m = 2 * n + 1;
+    let line: Vec<f64> = (0..m).map(|i| p[n * m + i]).collect();
+    let lo = p.iter().cloned().fold(f64::INFINITY, f64::min);
+    let hi = p.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    (lo, hi, line)
+}
+
+#[test]
+fn supg_removes_the_oscillations_of_an_advection_dominated_problem() {
+    // Exact solution: P ~ X away from the layers (outflow layer at X = 1 of width 1e-6,
+    // characteristic layers at Z = 0, 1), 0 <= P < 1.
+    let (lo_g, hi_g, line_g) = boundary_layer(Stabilisation::none());
+    let (lo_s, hi_s, line_s) = boundary_layer(Stabilisation::supg(1.0));
+    let m = line_s.len();
+    let dx = 1.0 / (m - 1) as f64;
+    // centre-line error against the reduced solution P = X upstream of the outflow layer
+    // (X <= 3/4: SUPG smears the layer over about two elements, h = 1/16)
+    let upstream = |line: &[f64]| {
+        (0..=(3 * (m - 1)) / 4)
+            .map(|i| (line[i] - i as f64 * dx).abs())
+            .fold(0.0, f64::max)
+    };
+    let wiggles = |line: &[f64]| {
+        (1..m - 1)
+            .filter(|&i| line[i] < line[i - 1] - 1e-12 && line[i + 1] > line[i] + 1e-12)
+            .count()
+    };
+    println!(
+        "Galerkin: min {lo_g:.3e} max {hi_g:.3e}, upstream error {:.3e}, local minima {}",
+        upstream(&line_g),
+        wiggles(&line_g)
+    );
+    println!(
+        "SUPG    : min {lo_s:.3e} max {hi_s:.3e}, upstream error {:.3e}, local minima {}",
+        upstream(&line_s),
+        wiggles(&line_s)
+    );
+    println!(
+        "centre line Galerkin {:?}",
+        line_g
+            .iter()
+            .map(|x| (x * 1000.0).round() / 1000.0)
+            .collect::<Vec<_>>()
+    );
+    println!(
+        "centre line SUPG     {:?}",
+        line_s
+            .iter()
+            .map(|x| (x * 1000.0).round() / 1000.0)
+            .collect::<Vec<_>>()
+    );
+    // Galerkin oscillates with O(1) amplitude all the way upstream, and overshoots wildly
+    assert!(upstream(&line_g) > 0.5 && wiggles(&line_g) > 5 && hi_g > 2.0 && lo_g < -1.0);
+    // SUPG: no interior local minimum on the centre line (no oscillation), accurate
+    // upstream of the layer, no overshoot above the exact bound 1 or below 0
+    assert!(upstream(&line_s) < 1e-2, "{}", upstream(&line_s));
+    assert_eq!(wiggles(&line_s), 0);
+    assert!(hi_s < 1.0 && lo_s > -1e-3, "SUPG min {lo_s} max {hi_s}");
+}
