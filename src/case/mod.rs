@@ -1,1 +1,348 @@
-//! case
+//! The scene file (`case.toml`): schema, units, strict validation and which effects are on.
+//!
+//! Entry points: [`load_scene`] (from a file) and [`parse_scene`] (from text). Both return
+//! a fully validated [`Scene`] in SI units, or a [`SceneError`] whose Display is one clear
+//! message naming the dotted key, the value and what is allowed.
+//!
+//! Validation runs in three passes:
+//! 1. the text is parsed into a `toml::Table` and walked against the key lists of
+//!    [`schema`] ([`spec::check_table`]): unknown keys (with the closest known key
+//!    suggested), missing required keys, wrong types, non-finite and out-of-range numbers,
+//!    unknown choices;
+//! 2. serde deserialises the table into [`Scene`] (defaults filled in);
+//! 3. cross-field checks ([`Scene::validate`]): Reynolds rectangle inside the cube's top face,
+//!    lubricant and entrainment speed present when lubricated, Roelands-only keys, etc.
+//!
+//! [`reference_markdown`] renders the schema (keys, meaning, unit, range, default) as
+//! Markdown for the README.
+pub mod error;
+pub mod schema;
+pub mod spec;
+
+use std::path::Path;
+
+use serde::Deserialize;
+
+pub use error::{SceneError, SceneErrorKind};
+pub use schema::*;
+
+use crate::physics::{
+    equivalent_solid, DensityLaw, HamrockDowson, Hertz, Kinematics, Material, MoesParameters,
+    Scales, ViscosityLaw,
+};
+use spec::fmt_num;
+
+/// Reads and validates the scene file at `path`. The scene name defaults to the file stem,
+/// or to the parent directory's name when the file is called `case.toml` or `scene.toml`.
+/// Every error names the file.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| SceneError::new(SceneErrorKind::Io(e)).in_file(path.to_path_buf()))?;
+    parse_scene(&text, &default_name(path)).map_err(|e| e.in_file(path.to_path_buf()))
+}
+
+fn default_name(path: &Path) -> String {
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
+    if stem == "case" || stem == "scene" {
+        let parent = path
+            .parent()
+            .and_then(|p| p.file_name())
+            .and_then(|s| s.to_str());
+        if let Some(p) = parent.filter(|p| !p.is_empty()) {
+            return p.to_string();
+        }
+    }
+    stem.to_string()
+}
+
+/// Parses and validates scene text; `default_name` is used when the text has no `name`.
+pub fn parse_scene(text: &str, default_name: &str) -> Result<Scene, SceneError> {
+    let table: toml::Table =
+        toml::from_str(text).map_err(|e| SceneErrorKind::Syntax(syntax_message(text, &e)))?;
+    spec::check_table(SCENE_FIELDS, &table, SCENE_FIELDS, "")?;
+    let mut scene = Scene::deserialize(toml::Value::Table(table))
+        .map_err(|e| SceneErrorKind::Syntax(format!("scene does not match the schema: {e}")))?;
+    if scene.name.is_empty() {
+        if default_name.trim().is_empty() {
+            return Err(SceneErrorKind::MissingField {
+                path: "name".into(),
+                description: "scene name, used for the default output directory".into(),
+            }
+            .into());
+        }
+        scene.name = default_name.to_string();
+    }
+    if scene.output.dir.is_empty() {
+        scene.output.dir = format!("out/{}", scene.name);
+    }
+    scene.validate()?;
+    Ok(scene)
+}
+
+/// One-line TOML syntax message: `line L, column C: what`.
+fn syntax_message(text: &str, e: &toml::de::Error) -> String {
+    let what = e.message().trim().replace('\n', "; ");
+    match e.span() {
+        Some(span) => {
+            let before = &text[..span.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            format!("line {line}, column {column}: {what}")
+        }
+        None => what,
+    }
+}
+
+/// The schema as Markdown tables (key, meaning, unit, allowed values, default), for the
+/// README reference.
+pub fn reference_markdown() -> String {
+    spec::reference_markdown(SCENE_FIELDS)
+}
+
+fn missing(path: &str) -> SceneError {
+    let f = spec::lookup(SCENE_FIELDS, path).expect("schema path");
+    let description = f.description_with_condition();
+    let path = path.to_string();
+    match f.kind {
+        spec::Kind::Table(_) => SceneErrorKind::MissingSection { path, description },
+        _ => SceneErrorKind::MissingField { path, description },
+    }
+    .into()
+}
+
+fn not_allowed(path: &str, value: f64, allowed: String) -> SceneError {
+    SceneErrorKind::NotAllowed {
+        path: path.into(),
+        value: fmt_num(value),
+        allowed,
+    }
+    .into()
+}
+
+impl Scene {
+    /// Cross-field checks (pass 3). Single-field ranges were checked while parsing;
+    /// this is public so that programmatically built scenes can be checked too.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        self.validate_fields_finite()?;
+        let r = &self.reynolds;
+        let half = self.mesh.cube_size / 2.0;
+        // Containment of the Hertz circle (x_min <= -1 <= 1 <= x_max, same in z, hence also
+        // x_min < x_max) is a single-field range checked by the walk above; what remains is
+        // the cross-field bound by the cube.
+        for (v, name) in [
+            (r.x_min, "x_min"),
+            (r.x_max, "x_max"),
+            (r.z_min, "z_min"),
+            (r.z_max, "z_max"),
+        ] {
+            if v.abs() >= half {
+                return Err(not_allowed(
+                    &format!("reynolds.{name}"),
+                    v,
+                    format!(
+                        "|{name}| must be < mesh.cube_size/2 = {} (units of a) so that the Reynolds rectangle lies inside the top face of the cube",
+                        fmt_num(half)
+                    ),
+                ));
+            }
+        }
+
+        let e = &self.effects;
+        if let Some(l) = &self.lubricant {
+            if l.roelands_exponent.is_some() && e.viscosity != ViscosityModel::Roelands {
+                return Err(SceneErrorKind::Conflict(format!(
+                    "lubricant.roelands_exponent is given but effects.viscosity = \"{}\": the Roelands index z_R is only used by the Roelands law (remove lubricant.roelands_exponent or set effects.viscosity = \"roelands\")",
+                    e.viscosity
+                ))
+                .into());
+            }
+            let needs_alpha = match e.viscosity {
+                ViscosityModel::Barus => true,
+                ViscosityModel::Roelands => l.roelands_exponent.is_none(),
+                ViscosityModel::Constant => false,
+            };
+            if needs_alpha && l.pressure_viscosity.is_none() {
+                return Err(missing("lubricant.pressure_viscosity"));
+            }
+            if e.viscosity == ViscosityModel::Roelands {
+                if let Err(msg) = self.viscosity_law_unchecked(l) {
+                    return Err(not_allowed(
+                        "lubricant.viscosity",
+                        l.viscosity,
+                        format!("with effects.viscosity = \"roelands\" it must exceed 6.31e-5 Pa.s ({msg})"),
+                    ));
+                }
+            }
+        }
+        if e.lubrication == LubricationModel::Reynolds {
+            if self.lubricant.is_none() {
+                return Err(missing("lubricant"));
+            }
+            if self.operating.entrainment_speed.is_none() {
+                return Err(missing("operating.entrainment_speed"));
+            }
+        }
+        if let Some(ue) = self.operating.entrainment_speed {
+            // Kinematics must be constructible (guards against programmatic scenes).
+            Kinematics::new(
+                ue,
+                self.operating.slide_to_roll,
+                self.tilt_angle_rad(),
+                self.geometry.ball_radius,
+                self.geometry.disc_track_radius,
+            )
+            .map_err(|err| {
+                not_allowed(
+                    "operating.tilt_angle",
+                    self.operating.tilt_angle,
+                    err.to_string(),
+                )
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Re-checks single-field ranges (already done while parsing a file) so that scenes
+    /// built in code get the same guarantees.
+    fn validate_fields_finite(&self) -> Result<(), SceneError> {
+        let value = toml::Value::try_from(self).map_err(|e| {
+            SceneErrorKind::Conflict(format!("scene cannot be represented as TOML: {e}"))
+        })?;
+        match value {
+            toml::Value::Table(t) => {
+                spec::check_table(SCENE_FIELDS, &t, SCENE_FIELDS, "").map_err(Into::into)
+            }
+            _ => unreachable!("a struct serialises to a table"),
+        }
+    }
+
+    /// Tilt angle lambda in radians.
+    pub fn tilt_angle_rad(&self) -> f64 {
+        self.operating.tilt_angle.to_radians()
+    }
+
+    /// Material of the ball B.
+    pub fn ball_material(&self) -> Material {
+        let m = self.materials.ball;
+        Material::new(m.young_modulus, m.poisson_ratio)
+    }
+
+    /// Material of the disc D.
+    pub fn disc_material(&self) -> Material {
+        let m = self.materials.disc;
+        Material::new(m.young_modulus, m.poisson_ratio)
+    }
+
+    /// Dry Hertz solution (a, p_H, E') for the scene's load, ball radius and materials.
+    pub fn hertz(&self) -> Hertz {
+        Hertz::new(
+            self.operating.load,
+            self.geometry.ball_radius,
+            self.ball_material(),
+            self.disc_material(),
+        )
+    }
+
+    /// Material of the equivalent elastic solid (physics.md section 6).
+    pub fn equivalent_solid(&self) -> Material {
+        equivalent_solid(self.ball_material(), self.disc_material())
+    }
+
+    /// Hertzian scales (a, p_H, R, E') of the dimensionless solver.
+    pub fn scales(&self) -> Scales {
+        Scales::from_hertz(&self.hertz())
+    }
+
+    fn viscosity_law_unchecked(&self, l: &Lubricant) -> Result<ViscosityLaw, String> {
+        let alpha = l.pressure_viscosity.unwrap_or(0.0);
+        Ok(match self.effects.viscosity {
+            ViscosityModel::Constant => ViscosityLaw::Constant { eta_r: l.viscosity },
+            ViscosityModel::Barus => ViscosityLaw::Barus {
+                eta_r: l.viscosity,
+                alpha,
+            },
+            ViscosityModel::Roelands => ViscosityLaw::roelands(
+                l.viscosity,
+                alpha,
+                l.roelands_reference_pressure,
+                l.roelands_exponent,
+            )?,
+        })
+    }
+
+    /// The viscosity law selected by `effects.viscosity`, or None without a lubricant.
+    pub fn viscosity_law(&self) -> Option<ViscosityLaw> {
+        let l = self.lubricant.as_ref()?;
+        Some(self.viscosity_law_unchecked(l).expect("validated scene"))
+    }
+
+    /// The density law selected by `effects.density`, or None without a lubricant.
+    pub fn density_law(&self) -> Option<DensityLaw> {
+        let rho_r = self.lubricant.as_ref()?.density;
+        Some(match self.effects.density {
+            DensityModel::DowsonHigginson => DensityLaw::DowsonHigginson { rho_r },
+            DensityModel::Incompressible => DensityLaw::Incompressible { rho_r },
+        })
+    }
+
+    /// Surface kinematics selected by `effects.kinematics`, or None without an entrainment
+    /// speed (dry scenes).
+    pub fn kinematics(&self) -> Option<Kinematics> {
+        let ue = self.operating.entrainment_speed?;
+        let (srr, rb, rd) = (
+            self.operating.slide_to_roll,
+            self.geometry.ball_radius,
+            self.geometry.disc_track_radius,
+        );
+        Some(
+            match self.effects.kinematics {
+                KinematicsModel::Spin => Kinematics::new(ue, srr, self.tilt_angle_rad(), rb, rd),
+                KinematicsModel::Uniform => Kinematics::uniform(ue, srr, rb, rd),
+            }
+            .expect("validated scene"),
+        )
+    }
+
+    /// Pressure-viscosity coefficient used by the film references: `pressure_viscosity`
+    /// if given, else d ln eta/dp at p = 0 of the viscosity law.
+    pub fn effective_alpha(&self) -> Option<f64> {
+        let l = self.lubricant.as_ref()?;
+        l.pressure_viscosity.or_else(|| {
+            self.viscosity_law()
+                .map(|v| v.pressure_viscosity_at_ambient())
+        })
+    }
+
+    /// Moes / Hamrock-Dowson dimensionless groups, when lubricated.
+    pub fn moes(&self) -> Option<MoesParameters> {
+        let l = self.lubricant.as_ref()?;
+        let ue = self.operating.entrainment_speed?;
+        let h = self.hertz();
+        Some(MoesParameters::new(
+            h.load,
+            ue,
+            l.viscosity,
+            self.effective_alpha()?,
+            h.e_prime,
+            h.radius,
+        ))
+    }
+
+    /// Hamrock-Dowson reference films for this operating point (k = 1), when lubricated.
+    pub fn hamrock_dowson(&self) -> Option<HamrockDowson> {
+        let l = self.lubricant.as_ref()?;
+        let ue = self.operating.entrainment_speed?;
+        let h = self.hertz();
+        Some(HamrockDowson::circular(
+            h.load,
+            ue,
+            l.viscosity,
+            self.effective_alpha()?,
+            h.e_prime,
+            h.radius,
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests;
