@@ -96,7 +96,7 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
 /// Dispatches on what the scene asks to simulate.
 fn simulate(ctx: &Context, scene: &Scene) -> Result<(), String> {
     match scene.effects.lubrication {
-        crate::case::Lubrication::None => dry::run(ctx, scene),
+        crate::case::LubricationModel::Dry => dry::run(ctx, scene),
         _ => Err("the lubricated (Reynolds) solver is not implemented yet: set effects.lubrication = \"none\" for the dry Hertz scene".into()),
     }
 }

@@ -30,6 +30,7 @@ pub fn lubricant(scene: &Scene) -> Lubricant {
     let dens = scene.density_law().expect("lubricated scene");
     let eta_r = visc.reference_viscosity();
     let rho_r = dens.reference_density();
+    let _ = rho_r;
     Lubricant {
         eta: Box::new(move |p: f64| {
             let (e, de) = visc.viscosity_and_derivative(p * ph);
@@ -37,9 +38,10 @@ pub fn lubricant(scene: &Scene) -> Lubricant {
         }),
         rho: Box::new(move |p: f64| {
             let (r, dr) = dens.ratio_and_derivative(p * ph);
-            let _ = rho_r;
             (r, dr * ph)
         }),
+        d2eta: Box::new(move |p: f64| visc.viscosity_second_derivative(p * ph) * ph * ph / eta_r),
+        d2rho: Box::new(move |p: f64| dens.ratio_second_derivative(p * ph) * ph * ph),
     }
 }
 
@@ -100,7 +102,7 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
         traction: assembly::traction_factor(eq.nu),
         load: if half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 },
         penalty: scene.reynolds.penalty,
-        stabilisation: crate::reynolds::element::Stabilisation { supg: scene.reynolds.stabilisation.is_supg(), delta: 1.0 },
+        stabilisation: crate::reynolds::element::Stabilisation { supg: scene.reynolds.stabilisation == crate::case::Stabilisation::Supg, delta: 1.0 },
         velocity: Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue]),
         nu: eq.nu,
     };

@@ -3,3 +3,4 @@
 pub mod layout;
 pub mod prealloc;
 pub mod system;
+pub mod driver;

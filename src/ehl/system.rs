@@ -41,6 +41,9 @@ pub fn p2_tri_weights(area: f64) -> [f64; 6] {
 pub struct Lubricant {
     pub eta: Box<dyn Fn(f64) -> (f64, f64) + Send + Sync>,
     pub rho: Box<dyn Fn(f64) -> (f64, f64) + Send + Sync>,
+    /// Second derivatives (needed by the exact Jacobian of the SUPG term).
+    pub d2eta: Box<dyn Fn(f64) -> f64 + Send + Sync>,
+    pub d2rho: Box<dyn Fn(f64) -> f64 + Send + Sync>,
 }
 
 /// Everything the EHL residual needs besides the iterate.
@@ -192,7 +195,13 @@ impl<'a> EhlSystem<'a> {
     }
 
     fn fluid(&self) -> Fluid<'_> {
-        Fluid { eta: &*self.lubricant.eta, rho: &*self.lubricant.rho, lambda_bar: self.params.lambda_bar }
+        Fluid {
+            eta: &*self.lubricant.eta,
+            rho: &*self.lubricant.rho,
+            d2eta: &*self.lubricant.d2eta,
+            d2rho: &*self.lubricant.d2rho,
+            lambda_bar: self.params.lambda_bar,
+        }
     }
 
     /// Film thickness at every contact node (whole mesh; used by post-processing).

@@ -124,6 +124,21 @@ impl ViscosityLaw {
         (eta, eta * dl)
     }
 
+    /// d^2 eta/dp^2 (Pa.s/Pa^2): eta'' = eta (g^2 + g') with g = d ln eta/dp. The exact
+    /// Jacobian of the stabilised Reynolds residual needs it (the SUPG term contains d eps/dP).
+    pub fn viscosity_second_derivative(&self, p: f64) -> f64 {
+        let (eta, _) = self.viscosity_and_derivative(p);
+        let (_, g) = self.log_ratio_and_derivative(p);
+        let dg = match *self {
+            ViscosityLaw::Roelands { eta_r, p_r, z_r } if p >= 0.0 => {
+                let s = eta_r.ln() - ROELANDS_LN_ETA_INFINITY;
+                s * z_r * (z_r - 1.0) / (p_r * p_r) * (1.0 + p / p_r).powf(z_r - 2.0)
+            }
+            _ => 0.0,
+        };
+        eta * (g * g + dg)
+    }
+
     /// Pressure-viscosity coefficient at ambient pressure, d ln eta/dp at p = 0 (1/Pa).
     /// For Roelands with z_R derived from alpha this is alpha.
     pub fn pressure_viscosity_at_ambient(&self) -> f64 {
@@ -172,6 +187,18 @@ impl DensityLaw {
         }
     }
 
+    /// d^2(rho/rho_R)/dp^2 (1/Pa^2).
+    pub fn ratio_second_derivative(&self, p: f64) -> f64 {
+        match *self {
+            DensityLaw::DowsonHigginson { .. } if p >= 0.0 => {
+                let (c1, c2) = (DOWSON_HIGGINSON_C1, DOWSON_HIGGINSON_C2);
+                let d = c1 + p;
+                -2.0 * (c2 - 1.0) * c1 / (d * d * d)
+            }
+            _ => 0.0,
+        }
+    }
+
     /// Density rho(p) (kg/m^3) at pressure p (Pa).
     pub fn density(&self, p: f64) -> f64 {
         self.reference_density() * self.ratio_and_derivative(p).0
@@ -190,6 +217,23 @@ mod tests {
 
     fn table1_roelands() -> ViscosityLaw {
         ViscosityLaw::roelands(0.012, 23e-9, ROELANDS_REFERENCE_PRESSURE, None).unwrap()
+    }
+
+    #[test]
+    fn second_derivatives_match_finite_differences() {
+        let v = table1_roelands();
+        for p in [1e7, 3e8, 9e8] {
+            let h = 1e-4 * p;
+            let fd2 = (v.viscosity_derivative(p + h) - v.viscosity_derivative(p - h)) / (2.0 * h);
+            let ex = v.viscosity_second_derivative(p);
+            assert!((ex / fd2 - 1.0).abs() < 1e-6, "Roelands eta'' at {p}: {ex} vs {fd2}");
+            let d = DensityLaw::DowsonHigginson { rho_r: 870.0 };
+            let fd2 = (d.ratio_and_derivative(p + h).1 - d.ratio_and_derivative(p - h).1) / (2.0 * h);
+            let ex = d.ratio_second_derivative(p);
+            assert!((ex / fd2 - 1.0).abs() < 1e-6, "D-H rho'' at {p}: {ex} vs {fd2}");
+        }
+        let b = ViscosityLaw::Barus { eta_r: 0.012, alpha: 2e-8 };
+        assert!((b.viscosity_second_derivative(1e8) / (4e-16 * b.viscosity(1e8)) - 1.0).abs() < 1e-12);
     }
 
     #[test]
