@@ -29,7 +29,7 @@ fn dry_hertz_matches_half_space_and_is_rank_invariant() {
     let center_ref = -a * a / r;
     assert!(((uc - ua) / diff_ref - 1.0).abs() < 0.02, "u2(0) - u2(a) = {} vs half-space {}", uc - ua, diff_ref);
     assert!((uc / center_ref - 1.0).abs() < 0.03, "u2(0) = {uc} vs half-space {center_ref}");
-    assert_eq!(num(&s2, "elastic.u2_center_halfspace_m"), center_ref);
+    assert!((num(&s2, "elastic.u2_center_halfspace_m") / center_ref - 1.0).abs() < 1e-12);
     // Rank invariance: the same mesh and a direct solver, so only round-off may differ.
     let uc1 = num(&s1, "elastic.u2_center_m");
     assert!((uc1 / uc - 1.0).abs() < 1e-8, "1 rank {uc1} vs 2 ranks {uc}");
