@@ -2,6 +2,7 @@
 //! writes the results. `main.rs` only parses the command line and calls [`run`].
 pub mod collective;
 pub mod dry;
+pub mod lubricated;
 
 use crate::case::Scene;
 use crate::petsc::Petsc;
@@ -97,6 +98,6 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
 fn simulate(ctx: &Context, scene: &Scene) -> Result<(), String> {
     match scene.effects.lubrication {
         crate::case::LubricationModel::Dry => dry::run(ctx, scene),
-        _ => Err("the lubricated (Reynolds) solver is not implemented yet: set effects.lubrication = \"none\" for the dry Hertz scene".into()),
+        crate::case::LubricationModel::Reynolds => lubricated::run(ctx, scene),
     }
 }

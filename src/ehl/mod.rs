@@ -4,3 +4,4 @@ pub mod layout;
 pub mod prealloc;
 pub mod system;
 pub mod driver;
+pub mod post;

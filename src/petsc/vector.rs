@@ -37,9 +37,14 @@ impl Vector {
     }
 
     /// Adds (or inserts) values at global indices; call [`Vector::assemble`] afterwards.
+    /// Negative indices (eliminated unknowns) are skipped.
     pub fn set_values(&self, idx: &[i32], vals: &[f64], add: bool) -> Result<()> {
         if idx.len() != vals.len() {
             return Err(rust_error("Vector::set_values: index and value lengths differ"));
+        }
+        if idx.iter().any(|&i| i < 0) {
+            let (i, v): (Vec<i32>, Vec<f64>) = idx.iter().zip(vals).filter(|(&i, _)| i >= 0).map(|(&i, &v)| (i, v)).unzip();
+            return self.set_values(&i, &v, add);
         }
         let mode = if add { ffi::InsertMode_ADD_VALUES } else { ffi::InsertMode_INSERT_VALUES };
         pcall!(ffi::VecSetValues(self.raw, idx.len() as ffi::PetscInt, idx.as_ptr(), vals.as_ptr(), mode))
