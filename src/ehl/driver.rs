@@ -76,7 +76,7 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
 
     // Initial iterate: dry displacement, Hertz pressure, H0 from Hamrock-Dowson's hc.
     let scales = scene.scales();
-    let hc_guess = scene.hamrock_dowson().map(|hd| hd.central_film_thickness()).unwrap_or(1e-7) / scales.film_scale();
+    let hc_guess = (scene.hamrock_dowson().map(|hd| hd.central_film_thickness()).unwrap_or(0.0) / scales.film_scale()).max(0.02);
     let mut x0 = vec![0.0; layout.total()];
     for n in 0..mesh.nodes.len() {
         for c in 0..3 {
@@ -91,9 +91,25 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
             x0[p as usize] = hertz_load::hertz_pressure(c[0], c[2]);
         }
     }
+    if std::env::var("EHL_START").as_deref() == Ok("zero") {
+        for v in x0.iter_mut() {
+            *v = 0.0;
+        }
+    }
     let centre = mesh.locate_contact(0.0, 0.0).ok_or("contact centre not on the contact face")?;
     let uy_centre = crate::fem::p2_tri_eval(&mesh.contact_tris[centre.0].map(|n| x0[layout.u[n as usize][1].max(0) as usize] * f64::from(layout.u[n as usize][1] >= 0)), centre.1);
-    x0[layout.h0 as usize] = hc_guess + uy_centre;
+    // H0 from the estimated central film, raised if needed so that the starting film is
+    // positive everywhere (a coarse mesh's dry deflection is not flat in the contact).
+    let min_gap = mesh
+        .contact_nodes
+        .iter()
+        .map(|&n| {
+            let c = mesh.nodes[n as usize];
+            let d = layout.u[n as usize][1];
+            0.5 * (c[0] * c[0] + c[2] * c[2]) - if d >= 0 { x0[d as usize] } else { 0.0 }
+        })
+        .fold(f64::INFINITY, f64::min);
+    x0[layout.h0 as usize] = (hc_guess + uy_centre).max(0.5 * hc_guess - min_gap);
 
     let kin = scene.kinematics().expect("lubricated scene");
     let (a, ue) = (scales.a, scene.operating.entrainment_speed.unwrap());
@@ -118,6 +134,11 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
     set_newton_defaults().map_err(pe)?;
     let snes = Snes::new(comm, "").map_err(pe)?;
     ctx.log(format!("Newton from the Hertz start: {} unknowns ({} U, {} P, 1 H0)", layout.total(), layout.counts().0, layout.counts().1));
+    if std::env::var_os("EHL_CHECK_JACOBIAN").is_some() {
+        for (r, c, e) in check_jacobian(&mut system, layout, ctx.rank, &x0, &j).map_err(pe)? {
+            ctx.log(format!("Jacobian check: rows {r:2} cols {c:2}: max |J v - FD| / max |J v| = {e:.3e}"));
+        }
+    }
     let report = snes.solve(&mut system, &x, &j).map_err(pe)?;
     let steps = vec![format!("Newton from Hertz start: {} ({} iterations)", report.reason, report.iterations)];
     ctx.log(&steps[0]);
@@ -144,6 +165,69 @@ pub fn set_newton_defaults() -> petsc::Result<()> {
     set_default("-snes_max_it", "60")?;
     set_default("-snes_rtol", "1e-10")?;
     set_default("-snes_atol", "1e-11")?;
-    set_default("-snes_stol", "1e-14")?;
+    // A tiny step is not convergence: only the residual norm decides.
+    set_default("-snes_stol", "0")?;
     Ok(())
+}
+
+/// Directional finite-difference check of the exact Jacobian, block by block:
+/// for a random direction v restricted to one column block (U, P or H0), compares J v with
+/// (F(x + d v) - F(x - d v)) / (2 d) on each row block. Returns (row block, column block,
+/// relative error) for the 9 pairs. Collective.
+pub fn check_jacobian(system: &mut EhlSystem, layout: &Layout, rank: usize, x0: &[f64], j: &Matrix) -> petsc::Result<Vec<(String, String, f64)>> {
+    use crate::petsc::snes::Problem;
+    let comm = petsc::comm_world();
+    let n = layout.total();
+    let block_of = |i: usize| -> usize {
+        if i as i32 == layout.h0 {
+            return 2;
+        }
+        let r = layout.ranges.partition_point(|&s| s <= i) - 1;
+        if i - layout.ranges[r] < layout.n_u[r] { 0 } else { 1 }
+    };
+    let names = ["U", "P", "H0"];
+    system.jacobian(x0, j)?;
+    j.assemble()?;
+    let (lo, hi) = (layout.ranges[rank], layout.ranges[rank + 1]);
+    let mut out = Vec::new();
+    // Deterministic pseudo-random direction.
+    let mut seed: u64 = 12345;
+    let mut rnd = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    let dir_all: Vec<f64> = (0..n).map(|_| rnd()).collect();
+    for cb in 0..3 {
+        let v: Vec<f64> = (0..n).map(|i| if block_of(i) == cb { dir_all[i] } else { 0.0 }).collect();
+        let vmax = v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        let d = 1e-7 / vmax.max(1e-300);
+        let vv = Vector::new(comm, layout.local(rank))?;
+        vv.set_local_values(&v[lo..hi])?;
+        let jv = vv.duplicate()?;
+        j.mult(&vv, &jv)?;
+        let jv = jv.gather_all()?;
+        let eval = |s: &mut EhlSystem, xs: &[f64]| -> petsc::Result<Vec<f64>> {
+            let f = Vector::new(comm, layout.local(rank))?;
+            f.set_all(0.0)?;
+            s.residual(xs, &f)?;
+            f.assemble()?;
+            f.gather_all()
+        };
+        let xp: Vec<f64> = x0.iter().zip(&v).map(|(a, b)| a + d * b).collect();
+        let xm: Vec<f64> = x0.iter().zip(&v).map(|(a, b)| a - d * b).collect();
+        let (fp, fm) = (eval(system, &xp)?, eval(system, &xm)?);
+        for rb in 0..3 {
+            let (mut num, mut den) = (0.0f64, 0.0f64);
+            for i in 0..n {
+                if block_of(i) != rb {
+                    continue;
+                }
+                let fd = (fp[i] - fm[i]) / (2.0 * d);
+                num = num.max((fd - jv[i]).abs());
+                den = den.max(jv[i].abs().max(fd.abs()));
+            }
+            out.push((names[rb].to_string(), names[cb].to_string(), if den > 0.0 { num / den } else { 0.0 }));
+        }
+    }
+    Ok(out)
 }

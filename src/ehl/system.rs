@@ -96,6 +96,8 @@ pub struct EhlSystem<'a> {
     /// Counters for reports.
     pub residual_evals: usize,
     pub jacobian_evals: usize,
+    /// Step-limiter factors applied at each Newton step (1 = full Newton step).
+    pub step_limits: Vec<f64>,
 }
 
 impl<'a> EhlSystem<'a> {
@@ -172,6 +174,7 @@ impl<'a> EhlSystem<'a> {
             ku_work,
             residual_evals: 0,
             jacobian_evals: 0,
+            step_limits: Vec::new(),
         })
     }
 
@@ -307,9 +310,48 @@ impl Problem for EhlSystem<'_> {
                 f.set_values(&[d], &[self.params.penalty * area * p], true)?;
             }
         }
+        if std::env::var_os("EHL_DEBUG").is_some() {
+            let mut maxr: f64 = 0.0;
+            let mut at = 0;
+            let fluid2 = self.fluid();
+            for (k, e) in self.elements.iter().enumerate() {
+                let p = self.element_pressure(x, e);
+                let h = self.element_film(x, e);
+                let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid2, &self.params.stabilisation);
+                let m = out.r.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+                if m > maxr { maxr = m; at = k; }
+            }
+            let e = &self.elements[at];
+            eprintln!("EHL_DEBUG max |R_reynolds| = {maxr:.3e} at element {:?} P = {:?} H = {:?}", e.verts, self.element_pressure(x, e), self.element_film(x, e));
+            eprintln!("EHL_DEBUG max |KU| = {:.3e}, h0 = {}", ku.iter().fold(0.0f64, |a, b| a.max(b.abs())), x[self.layout.h0 as usize]);
+        }
         let target = if self.rank == self.layout.ranges.len() - 2 { -self.params.load } else { 0.0 };
         f.set_values(&[self.layout.h0], &[load_part + target], true)?;
         Ok(Eval::Ok)
+    }
+
+    /// Fraction to the boundary: the Newton update may shrink the film at any contact node
+    /// to no less than `FILM_KEEP` of its current value (H stays positive).
+    fn limit_step(&mut self, x: &[f64], y: &[f64]) -> Result<f64> {
+        const FILM_KEEP: f64 = 0.2;
+        let dh0 = y[self.layout.h0 as usize];
+        let mut s: f64 = 1.0;
+        for &n in &self.mesh.contact_nodes {
+            let c = self.mesh.nodes[n as usize];
+            let d = self.layout.u[n as usize][1];
+            let (uy, duy) = if d < 0 { (0.0, 0.0) } else { (x[d as usize], y[d as usize]) };
+            let h = x[self.layout.h0 as usize] + 0.5 * (c[0] * c[0] + c[2] * c[2]) - uy;
+            // x_new = x - y: H_new = H - (dh0 - duy)
+            let dh = dh0 - duy;
+            if dh > 0.0 && h > 0.0 {
+                s = s.min((1.0 - FILM_KEEP) * h / dh);
+            }
+        }
+        self.step_limits.push(s);
+        if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
+            eprintln!("EHL_DEBUG step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e}", x[self.layout.h0 as usize]);
+        }
+        Ok(s)
     }
 
     fn jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
@@ -339,7 +381,10 @@ impl Problem for EhlSystem<'_> {
             j.add_values(&rows_p, &[self.layout.h0], &dh0)?;
         }
         for &(d, _n, area) in &self.penalty_nodes {
-            if x[d as usize] < 0.0 {
+            // Active set includes P = 0 exactly (the kink): nodes sitting at zero pressure,
+            // e.g. outside the Hertz circle at the start, stay put instead of being pushed
+            // negative by a Newton direction that ignores the penalty.
+            if x[d as usize] <= 0.0 {
                 j.add_values(&[d], &[d], &[self.params.penalty * area])?;
             }
         }

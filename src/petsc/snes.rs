@@ -26,6 +26,12 @@ pub trait Problem {
     fn residual(&mut self, x: &[f64], f: &Vector) -> Result<Eval>;
     /// Fills `j` (this rank's contributions; the problem decides what to zero); `x` is the whole iterate.
     fn jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()>;
+    /// Step limiter called before each line search with the iterate `x` and the Newton
+    /// direction `y` (the update is x - lambda y): returns a factor in (0, 1] that scales
+    /// y, e.g. to keep a physical quantity positive (fraction to the boundary).
+    fn limit_step(&mut self, _x: &[f64], _y: &[f64]) -> Result<f64> {
+        Ok(1.0)
+    }
 }
 
 struct Context<'a> {
@@ -101,6 +107,35 @@ unsafe extern "C" fn form_jacobian(_snes: ffi::SNES, x: ffi::Vec, j: ffi::Mat, _
     }
 }
 
+unsafe extern "C" fn precheck(_ls: ffi::SNESLineSearch, x: ffi::Vec, y: ffi::Vec, changed: *mut ffi::PetscBool, ctx: *mut c_void) -> ffi::PetscErrorCode {
+    let ctx = &mut *(ctx as *mut Context);
+    let run = || -> Result<bool> {
+        let xv = std::mem::ManuallyDrop::new(Vector { raw: x });
+        let yv = std::mem::ManuallyDrop::new(Vector { raw: y });
+        let (xa, ya) = (xv.gather_all()?, yv.gather_all()?);
+        let s = ctx.problem.limit_step(&xa, &ya)?;
+        if s < 1.0 {
+            pcall!(ffi::VecScale(y, s))?;
+            return Ok(true);
+        }
+        Ok(false)
+    };
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+        Ok(Ok(ch)) => {
+            *changed = if ch { ffi::PetscBool_PETSC_TRUE } else { ffi::PetscBool_PETSC_FALSE };
+            0
+        }
+        Ok(Err(e)) => {
+            ctx.error = Some(e);
+            ffi::PETSC_ERR_LIB as ffi::PetscErrorCode
+        }
+        Err(_) => {
+            ctx.error = Some(rust_error("panic in the step limiter"));
+            ffi::PETSC_ERR_LIB as ffi::PetscErrorCode
+        }
+    }
+}
+
 impl Snes {
     /// A SNES configured from the options database (with `prefix`, e.g. "" or "ehl_").
     pub fn new(comm: ffi::MPI_Comm, prefix: &str) -> Result<Snes> {
@@ -123,9 +158,13 @@ impl Snes {
         pcall!(ffi::SNESSetFunction(self.raw, r.raw, Some(form_function), ctxp))?;
         pcall!(ffi::SNESSetJacobian(self.raw, j.raw, j.raw, Some(form_jacobian), ctxp))?;
         pcall!(ffi::SNESSetFromOptions(self.raw))?;
+        let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
+        pcall!(ffi::SNESGetLineSearch(self.raw, &mut ls))?;
+        pcall!(ffi::SNESLineSearchSetPreCheck(ls, Some(precheck), ctxp))?;
         let code = unsafe { ffi::SNESSolve(self.raw, std::ptr::null_mut(), x.raw) };
         // Detach the callbacks' context before it goes out of scope.
         let _ = unsafe { ffi::SNESSetFunction(self.raw, r.raw, None, std::ptr::null_mut()) };
+        let _ = unsafe { ffi::SNESLineSearchSetPreCheck(ls, None, std::ptr::null_mut()) };
         if let Some(e) = ctx.error.take() {
             let _ = check(code);
             return Err(e);

@@ -98,6 +98,12 @@ pub struct ElementOut {
 /// Upwind function xi(Pe) = coth(Pe) - 1/Pe and its derivative.
 /// xi ~ Pe/3 for small Pe (series below Pe = 1e-2, avoiding cancellation), xi -> 1 for large Pe.
 pub fn xi(pe: f64) -> (f64, f64) {
+    if pe < 0.0 {
+        // xi is odd; a negative Peclet number only arises from an unphysical (negative)
+        // film inside an element, where the stabilisation must stay bounded.
+        let (v, d) = xi(-pe);
+        return (-v, d);
+    }
     if pe < 1e-2 {
         let p2 = pe * pe;
         (
