@@ -1,4 +1,9 @@
-//! Result files: summary.json (written once, atomically, only after success).
+//! Result files: summary.json (written once, atomically, only after success), CSV tables,
+//! VTU fields for ParaView and PNG plots.
+pub mod csv;
+pub mod plot;
+pub mod vtu;
+
 use std::io::Write;
 use std::path::Path;
 
