@@ -16,7 +16,8 @@ Exit codes: 0 success, 1 solve failed or did not converge, 2 bad scene or output
 #[command(name = "ehl-petsc", version, disable_help_flag = true, disable_version_flag = true, after_help = AFTER_HELP, trailing_var_arg = true)]
 struct Cli {
     /// Scene file (TOML): geometry, materials, lubricant, operating point, mesh, outputs
-    scene: PathBuf,
+    #[arg(required_unless_present = "scene_reference")]
+    scene: Option<PathBuf>,
     /// PETSc options, e.g. -ksp_view -log_view -snes_monitor (single dash, after the scene)
     #[arg(allow_hyphen_values = true, value_name = "PETSC_OPTIONS")]
     petsc_args: Vec<String>,
@@ -29,6 +30,9 @@ struct Cli {
     /// Print only errors
     #[arg(long)]
     quiet: bool,
+    /// Print the scene-file reference (every key, unit, range, default) as Markdown and exit
+    #[arg(long)]
+    scene_reference: bool,
     /// Print help (PETSc's own help: -help after the scene)
     #[arg(long, action = ArgAction::Help)]
     help: Option<bool>,
@@ -39,6 +43,10 @@ struct Cli {
 
 fn main() {
     let cli = Cli::parse();
+    if cli.scene_reference {
+        print!("{}", ehl_petsc::case::reference_markdown());
+        return;
+    }
     let Some(universe) = mpi::initialize() else {
         eprintln!("ehl-petsc: error: MPI could not be initialised");
         std::process::exit(3);
@@ -52,7 +60,7 @@ fn main() {
         unsafe { mpi::ffi::MPI_Abort(mpi::ffi::RSMPI_COMM_WORLD, 70) };
     }));
     let opts = ehl_petsc::app::RunOptions {
-        scene: cli.scene,
+        scene: cli.scene.expect("clap requires the scene"),
         output: cli.output,
         petsc_args: cli.petsc_args,
         check_only: cli.check,

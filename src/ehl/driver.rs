@@ -117,8 +117,12 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
         lambda_bar: lambda_bar(scene),
         traction: assembly::traction_factor(eq.nu),
         load: if half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 },
-        penalty: scene.reynolds.penalty,
-        stabilisation: crate::reynolds::element::Stabilisation { supg: scene.reynolds.stabilisation == crate::case::Stabilisation::Supg, delta: 1.0 },
+        penalty: if scene.effects.cavitation == crate::case::CavitationModel::Penalty { scene.reynolds.penalty } else { 0.0 },
+        stabilisation: crate::reynolds::element::Stabilisation {
+            supg: scene.reynolds.stabilisation == crate::case::Stabilisation::Supg,
+            delta: 1.0,
+            id: std::env::var("EHL_ID").ok().and_then(|v| v.parse().ok()).unwrap_or(0.0),
+        },
         velocity: Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue]),
         nu: eq.nu,
     };
@@ -134,6 +138,9 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
     set_newton_defaults().map_err(pe)?;
     let snes = Snes::new(comm, "").map_err(pe)?;
     ctx.log(format!("Newton from the Hertz start: {} unknowns ({} U, {} P, 1 H0)", layout.total(), layout.counts().0, layout.counts().1));
+    if std::env::var_os("EHL_NO_ROW_SCALING").is_none() {
+        system.scale_rows(&x0).map_err(pe)?;
+    }
     if std::env::var_os("EHL_CHECK_JACOBIAN").is_some() {
         for (r, c, e) in check_jacobian(&mut system, layout, ctx.rank, &x0, &j).map_err(pe)? {
             ctx.log(format!("Jacobian check: rows {r:2} cols {c:2}: max |J v - FD| / max |J v| = {e:.3e}"));
@@ -143,6 +150,17 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
     let steps = vec![format!("Newton from Hertz start: {} ({} iterations)", report.reason, report.iterations)];
     ctx.log(&steps[0]);
     let solve_s = t1.elapsed().as_secs_f64();
+    if !report.converged && std::env::var_os("EHL_DEBUG").is_some() && ctx.rank == 0 {
+        let xs = x.gather_all().map_err(pe)?;
+        let f = super::post::FieldsOnFace::new(mesh, layout, &xs);
+        let mut t = String::from("x,z,p,h\n");
+        for r in f.profile([mesh.spec.contact.x0, 0.0], [mesh.spec.contact.x1, 0.0], 241) {
+            t.push_str(&format!("{},{},{},{}\n", r[0], r[1], r[2], r[3]));
+        }
+        let _ = std::fs::write(ctx.out_dir.join("debug_profile_z0.csv"), t);
+    } else if !report.converged && std::env::var_os("EHL_DEBUG").is_some() {
+        x.gather_all().map_err(pe)?;
+    }
     if !report.converged {
         return Err(format!(
             "Newton did not converge: {} after {} iterations (residual norm {:.3e}){}",

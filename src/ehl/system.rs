@@ -37,6 +37,20 @@ pub fn p2_tri_weights(area: f64) -> [f64; 6] {
     [0.0, 0.0, 0.0, area / 3.0, area / 3.0, area / 3.0]
 }
 
+/// Width delta (in units of p_H) of the smoothed cavitation penalty; 0 gives the plain
+/// min(P, 0).
+pub const CAVITATION_SMOOTHING: f64 = 1e-3;
+
+/// The cavitation penalty function and its derivative: (P - sqrt(P^2 + delta^2))/2, a smooth
+/// version of min(P, 0) (equal to it up to O(delta^2 / |P|)).
+pub fn penalty_law(p: f64) -> (f64, f64) {
+    if CAVITATION_SMOOTHING == 0.0 {
+        return if p < 0.0 { (p, 1.0) } else { (0.0, 0.0) };
+    }
+    let r = (p * p + CAVITATION_SMOOTHING * CAVITATION_SMOOTHING).sqrt();
+    (0.5 * (p - r), 0.5 * (1.0 - p / r))
+}
+
 /// Lubricant laws in dimensionless form: eta_bar(P), rho_bar(P) with their P-derivatives.
 pub struct Lubricant {
     pub eta: Box<dyn Fn(f64) -> (f64, f64) + Send + Sync>,
@@ -98,6 +112,9 @@ pub struct EhlSystem<'a> {
     pub jacobian_evals: usize,
     /// Step-limiter factors applied at each Newton step (1 = full Newton step).
     pub step_limits: Vec<f64>,
+    /// Constant scale of each Reynolds row (indexed by global row), 1 by default; see
+    /// [`EhlSystem::scale_rows`].
+    row_scale: std::collections::HashMap<i32, f64>,
 }
 
 impl<'a> EhlSystem<'a> {
@@ -175,7 +192,45 @@ impl<'a> EhlSystem<'a> {
             residual_evals: 0,
             jacobian_evals: 0,
             step_limits: Vec::new(),
+            row_scale: std::collections::HashMap::new(),
         })
+    }
+
+    /// Scales each Reynolds row by the inverse of its Jacobian diagonal at `x` (held constant
+    /// afterwards, so the Jacobian stays exact and the solution unchanged). The rows' natural
+    /// sizes differ by ten orders of magnitude (eps ~ 1e4 at the inlet, ~1e-9 in the
+    /// contact); scaled, the residual norm that the line search watches weighs them alike.
+    pub fn scale_rows(&mut self, x: &[f64]) -> Result<()> {
+        let comm = crate::petsc::comm_world();
+        let diag = Vector::new(comm, self.layout.local(self.rank))?;
+        diag.set_all(0.0)?;
+        let fluid = self.fluid();
+        for e in &self.elements {
+            let p = self.element_pressure(x, e);
+            let h = self.element_film(x, e);
+            let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid, &self.params.stabilisation);
+            let rows: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
+            let d: [f64; 6] = std::array::from_fn(|i| out.dr_dp[i][i].abs());
+            diag.set_values(&rows, &d, true)?;
+        }
+        diag.assemble()?;
+        let all = diag.gather_all()?;
+        self.row_scale.clear();
+        for n in 0..self.mesh.nodes.len() {
+            let d = self.layout.p[n];
+            if d >= 0 {
+                let v = all[d as usize] + self.params.penalty * 1e-6;
+                self.row_scale.insert(d, if v > 0.0 { 1.0 / v } else { 1.0 });
+            }
+        }
+        Ok(())
+    }
+
+    fn scale_of(&self, row: i32) -> f64 {
+        if row < 0 {
+            return 0.0;
+        }
+        *self.row_scale.get(&row).unwrap_or(&1.0)
     }
 
     /// Nodal film thickness H = H0 + gap - U_y at the 6 nodes of a contact element.
@@ -301,13 +356,14 @@ impl Problem for EhlSystem<'_> {
             let h = self.element_film(x, e);
             let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid, &self.params.stabilisation);
             let rows_p: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
-            f.set_values(&rows_p, &out.r, true)?;
+            let r: [f64; 6] = std::array::from_fn(|i| out.r[i] * self.scale_of(rows_p[i]));
+            f.set_values(&rows_p, &r, true)?;
         }
         // Cavitation penalty on owned P nodes: xi * area_i * min(P_i, 0).
         for &(d, _n, area) in &self.penalty_nodes {
-            let p = x[d as usize];
-            if p < 0.0 {
-                f.set_values(&[d], &[self.params.penalty * area * p], true)?;
+            let (v, _) = penalty_law(x[d as usize]);
+            if v != 0.0 {
+                f.set_values(&[d], &[self.scale_of(d) * self.params.penalty * area * v], true)?;
             }
         }
         if std::env::var_os("EHL_DEBUG").is_some() {
@@ -336,6 +392,7 @@ impl Problem for EhlSystem<'_> {
         const FILM_KEEP: f64 = 0.2;
         let dh0 = y[self.layout.h0 as usize];
         let mut s: f64 = 1.0;
+        let mut at = [0.0; 4];
         for &n in &self.mesh.contact_nodes {
             let c = self.mesh.nodes[n as usize];
             let d = self.layout.u[n as usize][1];
@@ -343,13 +400,14 @@ impl Problem for EhlSystem<'_> {
             let h = x[self.layout.h0 as usize] + 0.5 * (c[0] * c[0] + c[2] * c[2]) - uy;
             // x_new = x - y: H_new = H - (dh0 - duy)
             let dh = dh0 - duy;
-            if dh > 0.0 && h > 0.0 {
-                s = s.min((1.0 - FILM_KEEP) * h / dh);
+            if dh > 0.0 && h > 0.0 && (1.0 - FILM_KEEP) * h / dh < s {
+                s = (1.0 - FILM_KEEP) * h / dh;
+                at = [c[0], c[2], h, dh];
             }
         }
         self.step_limits.push(s);
         if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
-            eprintln!("EHL_DEBUG step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e}", x[self.layout.h0 as usize]);
+            eprintln!("EHL_DEBUG step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e} binding at X,Z,H,dH = {at:?}", x[self.layout.h0 as usize]);
         }
         Ok(s)
     }
@@ -372,20 +430,23 @@ impl Problem for EhlSystem<'_> {
             let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid, &self.params.stabilisation);
             let rows_p: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
             let cols_uy: [i32; 6] = e.nodes.map(|n| self.layout.u[n as usize][1]);
+            let sc: [f64; 6] = rows_p.map(|r| self.scale_of(r));
             // dR/dP
-            j.add_values(&rows_p, &rows_p, out.dr_dp.as_flattened())?;
+            let dp: Vec<f64> = (0..36).map(|k| out.dr_dp[k / 6][k % 6] * sc[k / 6]).collect();
+            j.add_values(&rows_p, &rows_p, &dp)?;
             // dR/dU_y = -dR/dH ; dR/dH0 = sum_j dR/dH_j
-            let neg: Vec<f64> = out.dr_dh.iter().flat_map(|r| r.iter().map(|v| -v)).collect();
+            let neg: Vec<f64> = (0..36).map(|k| -out.dr_dh[k / 6][k % 6] * sc[k / 6]).collect();
             j.add_values(&rows_p, &cols_uy, &neg)?;
-            let dh0: [f64; 6] = out.dr_dh.map(|r| r.iter().sum());
+            let dh0: [f64; 6] = std::array::from_fn(|i| out.dr_dh[i].iter().sum::<f64>() * sc[i]);
             j.add_values(&rows_p, &[self.layout.h0], &dh0)?;
         }
         for &(d, _n, area) in &self.penalty_nodes {
             // Active set includes P = 0 exactly (the kink): nodes sitting at zero pressure,
             // e.g. outside the Hertz circle at the start, stay put instead of being pushed
             // negative by a Newton direction that ignores the penalty.
-            if x[d as usize] <= 0.0 {
-                j.add_values(&[d], &[d], &[self.params.penalty * area])?;
+            let (_, dv) = penalty_law(x[d as usize]);
+            if dv != 0.0 || x[d as usize] <= 0.0 {
+                j.add_values(&[d], &[d], &[self.scale_of(d) * self.params.penalty * area * dv.max(if CAVITATION_SMOOTHING > 0.0 { 0.0 } else { 1.0 })])?;
             }
         }
         self.jacobian_built = true;

@@ -1,10 +1,25 @@
 //! Lubricant laws (physics.md section 4): viscosity eta(p) and density rho(p), each with
 //! its exact derivative with respect to pressure (the Newton Jacobian needs both).
 //!
-//! Negative pressures: the penalty cavitation model lets p be slightly negative. Every law
-//! below is defined for all p; for p < 0 the pressure-dependent laws use their tangent at
-//! p = 0 (ln eta linear in p, rho linear in p), so the value and the first derivative are
-//! continuous at p = 0 and the derivative stays consistent with the value everywhere.
+//! Negative pressures: the penalty cavitation model lets p be slightly negative, and a
+//! Newton iterate may overshoot far below zero. Every law below is defined for all p; for
+//! p < 0 the pressure-dependent part saturates smoothly: ln(eta/eta_R) = s P_N tanh(p/P_N)
+//! and rho/rho_R = 1 + s' P_N tanh(p/P_N), with s, s' the slopes at p = 0 and
+//! P_N = [`NEGATIVE_PRESSURE_SCALE`]. Value and first derivative are continuous at p = 0,
+//! and the properties stay within a few per cent of their ambient values however negative
+//! p gets (a plain tangent let eta fall like exp(alpha p): an overshoot to -4 GPa gave
+//! eta/eta_R ~ 1e-42 and wrecked Newton).
+
+/// Pressure scale P_N (Pa) over which the laws saturate for p < 0 (see the module doc).
+pub const NEGATIVE_PRESSURE_SCALE: f64 = 1e7;
+
+/// (s P_N tanh(p/P_N), its first and second derivatives): the saturated extension for p < 0
+/// of a law with slope s at p = 0.
+fn saturated(slope: f64, p: f64) -> (f64, f64, f64) {
+    let t = (p / NEGATIVE_PRESSURE_SCALE).tanh();
+    let sech2 = 1.0 - t * t;
+    (slope * NEGATIVE_PRESSURE_SCALE * t, slope * sech2, -2.0 * slope / NEGATIVE_PRESSURE_SCALE * sech2 * t)
+}
 
 /// Default Roelands reference pressure P_R (Pa).
 pub const ROELANDS_REFERENCE_PRESSURE: f64 = 1.96e8;
@@ -35,8 +50,8 @@ pub enum ViscosityLaw {
     },
     /// Roelands (paper Eq. 6):
     /// eta = eta_R exp{ (ln eta_R + 9.67) [ -1 + (1 + p/P_R)^z_R ] } for p >= 0;
-    /// for p < 0, ln eta = ln eta_R + alpha* p with alpha* = (ln eta_R + 9.67) z_R / P_R,
-    /// the tangent at p = 0 (see the module doc).
+    /// for p < 0, ln eta = ln eta_R + alpha* P_N tanh(p/P_N) with
+    /// alpha* = (ln eta_R + 9.67) z_R / P_R (see the module doc).
     Roelands {
         /// Reference viscosity eta_R (Pa.s); must exceed exp(-9.67) = 6.31e-5 Pa.s.
         eta_r: f64,
@@ -92,7 +107,11 @@ impl ViscosityLaw {
     pub fn log_ratio_and_derivative(&self, p: f64) -> (f64, f64) {
         match *self {
             ViscosityLaw::Constant { .. } => (0.0, 0.0),
-            ViscosityLaw::Barus { alpha, .. } => (alpha * p, alpha),
+            ViscosityLaw::Barus { alpha, .. } if p >= 0.0 => (alpha * p, alpha),
+            ViscosityLaw::Barus { alpha, .. } => {
+                let (v, d, _) = saturated(alpha, p);
+                (v, d)
+            }
             ViscosityLaw::Roelands { eta_r, p_r, z_r } => {
                 let s = eta_r.ln() - ROELANDS_LN_ETA_INFINITY;
                 if p >= 0.0 {
@@ -100,8 +119,8 @@ impl ViscosityLaw {
                     let tz1 = t.powf(z_r - 1.0);
                     (s * (t * tz1 - 1.0), s * z_r * tz1 / p_r)
                 } else {
-                    let slope = s * z_r / p_r;
-                    (slope * p, slope)
+                    let (v, d, _) = saturated(s * z_r / p_r, p);
+                    (v, d)
                 }
             }
         }
@@ -134,6 +153,11 @@ impl ViscosityLaw {
                 let s = eta_r.ln() - ROELANDS_LN_ETA_INFINITY;
                 s * z_r * (z_r - 1.0) / (p_r * p_r) * (1.0 + p / p_r).powf(z_r - 2.0)
             }
+            ViscosityLaw::Roelands { eta_r, p_r, z_r } => {
+                let s = eta_r.ln() - ROELANDS_LN_ETA_INFINITY;
+                saturated(s * z_r / p_r, p).2
+            }
+            ViscosityLaw::Barus { alpha, .. } if p < 0.0 => saturated(alpha, p).2,
             _ => 0.0,
         };
         eta * (g * g + dg)
@@ -155,7 +179,7 @@ pub enum DensityLaw {
         rho_r: f64,
     },
     /// Dowson-Higginson: rho/rho_R = (5.9e8 + 1.34 p)/(5.9e8 + p) (p in Pa) for p >= 0;
-    /// for p < 0 the tangent rho/rho_R = 1 + 0.34 p/5.9e8 (see the module doc).
+    /// for p < 0, rho/rho_R = 1 + (0.34/5.9e8) P_N tanh(p/P_N) (see the module doc).
     DowsonHigginson {
         /// Reference density rho_R (kg/m^3).
         rho_r: f64,
@@ -180,8 +204,8 @@ impl DensityLaw {
                     let d = c1 + p;
                     ((c1 + c2 * p) / d, (c2 - 1.0) * c1 / (d * d))
                 } else {
-                    let slope = (c2 - 1.0) / c1;
-                    (1.0 + slope * p, slope)
+                    let (v, d, _) = saturated((c2 - 1.0) / c1, p);
+                    (1.0 + v, d)
                 }
             }
         }
@@ -195,6 +219,7 @@ impl DensityLaw {
                 let d = c1 + p;
                 -2.0 * (c2 - 1.0) * c1 / (d * d * d)
             }
+            DensityLaw::DowsonHigginson { .. } => saturated((DOWSON_HIGGINSON_C2 - 1.0) / DOWSON_HIGGINSON_C1, p).2,
             _ => 0.0,
         }
     }
@@ -222,7 +247,7 @@ mod tests {
     #[test]
     fn second_derivatives_match_finite_differences() {
         let v = table1_roelands();
-        for p in [1e7, 3e8, 9e8] {
+        for p in [-3e7, -1e6, 1e7, 3e8, 9e8] {
             let h = 1e-4 * p;
             let fd2 = (v.viscosity_derivative(p + h) - v.viscosity_derivative(p - h)) / (2.0 * h);
             let ex = v.viscosity_second_derivative(p);
@@ -320,9 +345,12 @@ mod tests {
         let (e_m, d_m) = l.viscosity_and_derivative(-1e-3);
         let (e_p, d_p) = l.viscosity_and_derivative(1e-3);
         assert!(rel(e_m, e_p) < 1e-9 && rel(d_m, d_p) < 1e-9);
-        // Far below -P_R it is still defined, positive and decreasing.
-        let e = l.viscosity(-1e9);
-        assert!(e > 0.0 && e < 0.012 && e.is_finite());
+        // Far below zero it saturates: positive, below eta_R, and within
+        // exp(-alpha P_N) = exp(-0.23) of eta_R however negative p gets.
+        for p in [-1e8, -1e9, -1e12] {
+            let e = l.viscosity(p);
+            assert!(e > 0.012 * (-23e-9 * NEGATIVE_PRESSURE_SCALE).exp() * 0.999 && e < 0.012, "eta({p}) = {e}");
+        }
     }
 
     #[test]
@@ -338,7 +366,9 @@ mod tests {
         // Limit 1.34 at infinite pressure, 1 at p = 0.
         assert_eq!(d.density(0.0), 870.0);
         assert!(rel(d.ratio_and_derivative(1e15).0, 1.34) < 1e-5);
-        for &p in &[-1e8, -1.0, 1.0, 1e8, 8.45e8, 3e9] {
+        // Saturated for p < 0: within 0.34 P_N / 5.9e8 of rho_R however negative p is.
+        assert!(d.density(-1e12) > 870.0 * (1.0 - 0.34 * NEGATIVE_PRESSURE_SCALE / 5.9e8) * 0.9999);
+        for &p in &[-1e7, -1.0, 1.0, 1e8, 8.45e8, 3e9] {
             let fdv = fd(|q| d.density(q), p, 1e-4 * p.abs().max(1e4));
             assert!(rel(d.density_derivative(p), fdv) < 1e-6, "p = {p}");
         }

@@ -58,6 +58,10 @@ pub struct Stabilisation {
     pub supg: bool,
     /// Multiplier delta of the stabilisation parameter tau (1.0 by default).
     pub delta: f64,
+    /// Isotropic artificial diffusion (Habchi et al.): eps_id = id * h_e * |beta| is added to
+    /// the diffusion coefficient of the Galerkin term, with beta = (d rho_bar/dP) H v the
+    /// convection velocity of P in the Couette term. Inconsistent by O(h): 0 switches it off.
+    pub id: f64,
 }
 
 impl Default for Stabilisation {
@@ -66,6 +70,7 @@ impl Default for Stabilisation {
         Self {
             supg: true,
             delta: 1.0,
+            id: 0.0,
         }
     }
 }
@@ -76,11 +81,12 @@ impl Stabilisation {
         Self {
             supg: false,
             delta: 1.0,
+            id: 0.0,
         }
     }
     /// SUPG with multiplier `delta`.
     pub fn supg(delta: f64) -> Self {
-        Self { supg: true, delta }
+        Self { supg: true, delta, id: 0.0 }
     }
 }
 
@@ -213,9 +219,21 @@ pub fn reynolds_element_with_source(
 
         // Galerkin: eps grad P . grad N_i - rho H (v . grad N_i) - f N_i
         let v_dn: [f64; 6] = std::array::from_fn(|i| v[0] * dn[i][0] + v[1] * dn[i][1]);
+        // Isotropic artificial diffusion eps_id = id h_e |rho' H v| (exact derivative through
+        // the duals: rho' is a dual built from rho'').
+        let eps_g = if stab.id > 0.0 {
+            let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
+            let h_e = streamline_length(&tri, v);
+            let drho_d = pq.chain(drho, (fluid.d2rho)(pq.v));
+            let beta = drho_d * hq * vn;
+            let beta_abs = if beta.v < 0.0 { -beta } else { beta };
+            eps + beta_abs * (stab.id * h_e)
+        } else {
+            eps
+        };
         for i in 0..6 {
             let flux = gp[0] * dn[i][0] + gp[1] * dn[i][1];
-            res[i] += (eps * flux - rho_h * v_dn[i] - f * n[i]) * wq;
+            res[i] += (eps_g * flux - rho_h * v_dn[i] - f * n[i]) * wq;
         }
 
         if stab.supg {
