@@ -566,7 +566,14 @@ pub struct ReynoldsDomain {
     pub penalty: f64,
     /// "supg" | "none"; default "supg".
     pub stabilisation: Stabilisation,
+    /// Isotropic artificial diffusion factor delta_ID >= 0 (Habchi et al.): eps_ID =
+    /// delta_ID h_e |(d rho_bar/dP) H u_bar| is added to the Reynolds diffusion coefficient;
+    /// it vanishes with the element size h_e; default 10; 0 switches it off.
+    pub artificial_diffusion: f64,
 }
+
+/// Default isotropic artificial diffusion factor.
+pub const DEFAULT_ARTIFICIAL_DIFFUSION: f64 = 10.0;
 
 impl Default for ReynoldsDomain {
     fn default() -> Self {
@@ -577,6 +584,7 @@ impl Default for ReynoldsDomain {
             z_max: 3.0,
             penalty: DEFAULT_PENALTY,
             stabilisation: Stabilisation::Supg,
+            artificial_diffusion: DEFAULT_ARTIFICIAL_DIFFUSION,
         }
     }
 }
@@ -594,6 +602,8 @@ pub const REYNOLDS_FIELDS: &[Field] = &[
     f!("penalty", "dimensionless cavitation penalty factor xi", "", Kind::Number(Range::Positive), Presence::Default("1e4")),
     f!("stabilisation", "stabilisation of the Reynolds equation", "", Kind::Choice(Stabilisation::NAMES),
         Presence::Default("\"supg\"")),
+    f!("artificial_diffusion", "isotropic artificial diffusion factor delta_ID (eps_ID = delta_ID h_e |rho' H u|; 0 = off)", "",
+        Kind::Number(Range::AtLeast(0.0)), Presence::Default("10")),
 ];
 
 // ---------------------------------------------------------------------------------------

@@ -121,7 +121,7 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
         stabilisation: crate::reynolds::element::Stabilisation {
             supg: scene.reynolds.stabilisation == crate::case::Stabilisation::Supg,
             delta: 1.0,
-            id: std::env::var("EHL_ID").ok().and_then(|v| v.parse().ok()).unwrap_or(0.0),
+            id: scene.reynolds.artificial_diffusion,
         },
         velocity: Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue]),
         nu: eq.nu,
@@ -146,9 +146,68 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
             ctx.log(format!("Jacobian check: rows {r:2} cols {c:2}: max |J v - FD| / max |J v| = {e:.3e}"));
         }
     }
+    // 1. Plain Newton from the Hertz start at the scene's operating point.
     let report = snes.solve(&mut system, &x, &j).map_err(pe)?;
-    let steps = vec![format!("Newton from Hertz start: {} ({} iterations)", report.reason, report.iterations)];
+    let mut steps = vec![format!("Newton from the Hertz start at L = {} N: {} ({} iterations)", scene.operating.load, report.reason, report.iterations)];
     ctx.log(&steps[0]);
+    let mut newton_total = report.iterations;
+    let mut last = report;
+    // 2. If it failed: continuation in load. A lighter load is a milder problem in Hertz
+    //    units (smaller M, alpha p_H); each converged state starts the next, heavier one.
+    if !last.converged {
+        let target = scene.operating.load;
+        let solve_at = |load: f64, system: &mut EhlSystem, start: &[f64]| -> Result<SolveReport, String> {
+            let mut sc = scene.clone();
+            sc.operating.load = load;
+            system.set_operating(lambda_bar(&sc), lubricant(&sc));
+            x.set_local_values(&start[lo..hi]).map_err(pe)?;
+            if std::env::var_os("EHL_NO_ROW_SCALING").is_none() {
+                system.scale_rows(start).map_err(pe)?;
+            }
+            snes.solve(system, &x, &j).map_err(pe)
+        };
+        // Find a light load that converges from the Hertz start.
+        let mut load = target / 8.0;
+        let mut state: Option<Vec<f64>> = None;
+        while load >= target / 64.0 {
+            let r = solve_at(load, &mut system, &x0)?;
+            newton_total += r.iterations;
+            steps.push(format!("continuation: Hertz start at L = {load:.4} N: {} ({} iterations)", r.reason, r.iterations));
+            ctx.log(steps.last().unwrap());
+            if r.converged {
+                state = Some(x.gather_all().map_err(pe)?);
+                break;
+            }
+            load /= 2.0;
+        }
+        let Some(mut state) = state else {
+            return Err(format!("Newton did not converge, not even with load continuation down to L = {:.4} N; steps: {}", target / 64.0, steps.join("; ")));
+        };
+        // Ramp the load up to the target, halving the step ratio on failure.
+        let mut ratio: f64 = 2.0;
+        while load < target {
+            let next = (load * ratio).min(target);
+            let r = solve_at(next, &mut system, &state)?;
+            newton_total += r.iterations;
+            steps.push(format!("continuation: L = {next:.4} N: {} ({} iterations)", r.reason, r.iterations));
+            ctx.log(steps.last().unwrap());
+            if r.converged {
+                state = x.gather_all().map_err(pe)?;
+                load = next;
+                last = r;
+            } else {
+                ratio = ratio.sqrt();
+                if ratio < 1.05 {
+                    last = r;
+                    break;
+                }
+            }
+        }
+        if load < target {
+            x.set_local_values(&state[lo..hi]).map_err(pe)?;
+        }
+    }
+    let report = last;
     let solve_s = t1.elapsed().as_secs_f64();
     if !report.converged && std::env::var_os("EHL_DEBUG").is_some() && ctx.rank == 0 {
         let xs = x.gather_all().map_err(pe)?;
@@ -163,14 +222,14 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
     }
     if !report.converged {
         return Err(format!(
-            "Newton did not converge: {} after {} iterations (residual norm {:.3e}){}",
+            "Newton did not converge: {} after {} iterations (residual norm {:.3e}){}; path: {}",
             report.reason,
             report.iterations,
             report.residual_norm,
-            report.domain_error.as_ref().map(|d| format!("; last domain error: {d}")).unwrap_or_default()
+            report.domain_error.as_ref().map(|d| format!("; last domain error: {d}")).unwrap_or_default(),
+            steps.join("; ")
         ));
     }
-    let newton_total = report.iterations;
     let xs = x.gather_all().map_err(pe)?;
     Ok(EhlSolution { x: xs, report, newton_total, steps, assembly_s, solve_s })
 }
@@ -180,7 +239,7 @@ pub fn set_newton_defaults() -> petsc::Result<()> {
     use petsc::options::set_default;
     set_default("-snes_type", "newtonls")?;
     set_default("-snes_linesearch_type", "bt")?;
-    set_default("-snes_max_it", "60")?;
+    set_default("-snes_max_it", "30")?;
     set_default("-snes_rtol", "1e-10")?;
     set_default("-snes_atol", "1e-11")?;
     // A tiny step is not convergence: only the residual norm decides.
