@@ -116,10 +116,7 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
             "peak_rss_mb_all_ranks": peak_total,
             "scene": scene,
         });
-        let path = ctx.out_dir.join("summary.json");
-        let text = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
-        crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        ctx.log(format!("wrote {}", path.display()));
+        ctx.write_summary(&summary)?;
     }
     Ok(())
 }

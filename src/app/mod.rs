@@ -40,6 +40,18 @@ impl Context {
     }
 }
 
+impl Context {
+    /// Writes summary.json into the output folder (rank 0 calls it, once, after success;
+    /// atomically, so a failed run leaves no summary behind).
+    pub fn write_summary(&self, summary: &serde_json::Value) -> Result<(), String> {
+        let path = self.out_dir.join("summary.json");
+        let text = serde_json::to_string_pretty(summary).map_err(|e| e.to_string())?;
+        crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        self.log(format!("wrote {}", path.display()));
+        Ok(())
+    }
+}
+
 /// Runs the program on every rank; returns the process exit code. Errors are printed by
 /// rank 0 (or by the rank that failed alone) on stderr.
 pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {

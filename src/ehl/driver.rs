@@ -1,6 +1,13 @@
 //! The lubricated solve: builds the coupled system, starts from the dry Hertz state,
 //! runs Newton (PETSc SNES, MUMPS LU), and falls back to an automatic continuation in
 //! load when Newton fails from the Hertz start.
+//!
+//! Developer diagnostics (environment variables, not part of the user interface):
+//! `EHL_CHECK_JACOBIAN=1` prints a block-by-block finite-difference check of the Jacobian at
+//! the start; `EHL_DEBUG=1` prints residual norms per block, the step limiter's binding node
+//! and writes `debug_profile_z0.csv` after a failure; `EHL_START=zero` starts from P = 0,
+//! U = 0; `EHL_NO_ROW_SCALING=1` and `EHL_NO_LIMIT=1` switch off the row scaling and the
+//! film step limiter.
 use super::layout::Layout;
 use super::prealloc::preallocation;
 use super::system::{EhlParams, EhlSystem, Lubricant};

@@ -57,14 +57,7 @@ impl P2Triangle {
 
     /// Shape function values at barycentric point `l`.
     pub fn shape(l: &[f64; 3]) -> [f64; 6] {
-        [
-            l[0] * (2.0 * l[0] - 1.0),
-            l[1] * (2.0 * l[1] - 1.0),
-            l[2] * (2.0 * l[2] - 1.0),
-            4.0 * l[0] * l[1],
-            4.0 * l[1] * l[2],
-            4.0 * l[2] * l[0],
-        ]
+        crate::fem::p2tri::p2_tri_basis_bary(*l)
     }
 
     /// Shape function gradients at barycentric point `l`.
