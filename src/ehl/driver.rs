@@ -36,8 +36,6 @@ pub fn lubricant(scene: &Scene) -> Lubricant {
     let visc = scene.viscosity_law().expect("lubricated scene");
     let dens = scene.density_law().expect("lubricated scene");
     let eta_r = visc.reference_viscosity();
-    let rho_r = dens.reference_density();
-    let _ = rho_r;
     Lubricant {
         eta: Box::new(move |p: f64| {
             let (e, de) = visc.viscosity_and_derivative(p * ph);
@@ -104,17 +102,13 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
         }
     }
     let centre = mesh.locate_contact(0.0, 0.0).ok_or("contact centre not on the contact face")?;
-    let uy_centre = crate::fem::p2_tri_eval(&mesh.contact_tris[centre.0].map(|n| x0[layout.u[n as usize][1].max(0) as usize] * f64::from(layout.u[n as usize][1] >= 0)), centre.1);
+    let uy_centre = crate::fem::p2_tri_eval(&mesh.contact_tris[centre.0].map(|n| layout.uy(&x0, n)), centre.1);
     // H0 from the estimated central film, raised if needed so that the starting film is
     // positive everywhere (a coarse mesh's dry deflection is not flat in the contact).
     let min_gap = mesh
         .contact_nodes
         .iter()
-        .map(|&n| {
-            let c = mesh.nodes[n as usize];
-            let d = layout.u[n as usize][1];
-            0.5 * (c[0] * c[0] + c[2] * c[2]) - if d >= 0 { x0[d as usize] } else { 0.0 }
-        })
+        .map(|&n| Layout::gap(mesh.nodes[n as usize]) - layout.uy(&x0, n))
         .fold(f64::INFINITY, f64::min);
     x0[layout.h0 as usize] = (hc_guess + uy_centre).max(0.5 * hc_guess - min_gap);
 

@@ -89,6 +89,26 @@ impl Layout {
         self.ranges[rank + 1] - self.ranges[rank]
     }
 
+    /// Value of an unknown at global index `d` of the iterate `x` (0 for -1: eliminated).
+    pub fn value(x: &[f64], d: i32) -> f64 {
+        if d < 0 { 0.0 } else { x[d as usize] }
+    }
+
+    /// Normal displacement U_y of node `n` in the iterate `x`.
+    pub fn uy(&self, x: &[f64], n: u32) -> f64 {
+        Self::value(x, self.u[n as usize][1])
+    }
+
+    /// The rigid gap of the ball at a node, (X^2 + Z^2)/2 (Eq. 5, dimensionless).
+    pub fn gap(c: [f64; 3]) -> f64 {
+        0.5 * (c[0] * c[0] + c[2] * c[2])
+    }
+
+    /// Film thickness H = H0 + (X^2 + Z^2)/2 - U_y at contact node `n` (physics.md Eq. 5).
+    pub fn film(&self, mesh: &Mesh, x: &[f64], n: u32) -> f64 {
+        x[self.h0 as usize] + Self::gap(mesh.nodes[n as usize]) - self.uy(x, n)
+    }
+
     /// Total displacement and pressure unknown counts.
     pub fn counts(&self) -> (usize, usize) {
         (self.n_u.iter().sum(), self.n_p.iter().sum())

@@ -32,22 +32,12 @@ impl<'a> FieldsOnFace<'a> {
 
     /// Nodal pressure P (0 on the Dirichlet edges).
     pub fn p_node(&self, n: u32) -> f64 {
-        let d = self.layout.p[n as usize];
-        if d < 0 { 0.0 } else { self.x[d as usize] }
+        Layout::value(self.x, self.layout.p[n as usize])
     }
 
     /// Nodal film H = H0 + (X^2 + Z^2)/2 - U_y.
     pub fn h_node(&self, n: u32) -> f64 {
-        let c = self.mesh.nodes[n as usize];
-        let d = self.layout.u[n as usize][1];
-        let uy = if d < 0 { 0.0 } else { self.x[d as usize] };
-        self.x[self.layout.h0 as usize] + 0.5 * (c[0] * c[0] + c[2] * c[2]) - uy
-    }
-
-    /// Normal surface displacement U_y at a node.
-    pub fn uy_node(&self, n: u32) -> f64 {
-        let d = self.layout.u[n as usize][1];
-        if d < 0 { 0.0 } else { self.x[d as usize] }
+        self.layout.film(self.mesh, self.x, n)
     }
 
     /// (P, H) at a point of the contact face, by P2 interpolation.

@@ -141,10 +141,7 @@ impl<'a> EhlSystem<'a> {
             };
             let verts = [xz(tri[0]), xz(tri[1]), xz(tri[2])];
             let vel = verts.map(|v| (params.velocity)(v[0], v[1]));
-            let gap = tri.map(|n| {
-                let c = mesh.nodes[n as usize];
-                0.5 * (c[0] * c[0] + c[2] * c[2])
-            });
+            let gap = tri.map(|n| Layout::gap(mesh.nodes[n as usize]));
             elements.push(ContactElement { nodes: *tri, verts, vel, gap, area: tri_area(&verts) });
         }
         // Nodal areas for the penalty, from all contact triangles (every rank sees the mesh).
@@ -244,20 +241,11 @@ impl<'a> EhlSystem<'a> {
     /// Nodal film thickness H = H0 + gap - U_y at the 6 nodes of a contact element.
     fn element_film(&self, x: &[f64], e: &ContactElement) -> [f64; 6] {
         let h0 = x[self.layout.h0 as usize];
-        let mut h = [0.0; 6];
-        for i in 0..6 {
-            let d = self.layout.u[e.nodes[i] as usize][1];
-            let uy = if d < 0 { 0.0 } else { x[d as usize] };
-            h[i] = h0 + e.gap[i] - uy;
-        }
-        h
+        std::array::from_fn(|i| h0 + e.gap[i] - self.layout.uy(x, e.nodes[i]))
     }
 
     fn element_pressure(&self, x: &[f64], e: &ContactElement) -> [f64; 6] {
-        e.nodes.map(|n| {
-            let d = self.layout.p[n as usize];
-            if d < 0 { 0.0 } else { x[d as usize] }
-        })
+        e.nodes.map(|n| Layout::value(x, self.layout.p[n as usize]))
     }
 
     fn fluid(&self) -> Fluid<'_> {
@@ -270,21 +258,6 @@ impl<'a> EhlSystem<'a> {
         }
     }
 
-    /// Film thickness at every contact node (whole mesh; used by post-processing).
-    pub fn nodal_film(&self, x: &[f64]) -> Vec<(u32, f64)> {
-        let h0 = x[self.layout.h0 as usize];
-        self.mesh
-            .contact_nodes
-            .iter()
-            .map(|&n| {
-                let c = self.mesh.nodes[n as usize];
-                let d = self.layout.u[n as usize][1];
-                let uy = if d < 0 { 0.0 } else { x[d as usize] };
-                (n, h0 + 0.5 * (c[0] * c[0] + c[2] * c[2]) - uy)
-            })
-            .collect()
-    }
-
     /// Writes the iterate's displacement block into the displacement-only work vector.
     fn load_u(&self, x: &[f64]) -> Result<()> {
         let base = self.layout.ranges[self.rank];
@@ -293,19 +266,13 @@ impl<'a> EhlSystem<'a> {
 
     /// Adds K (in layout numbering) into J, element by element (first Jacobian only).
     fn add_stiffness(&self, j: &Matrix) -> Result<()> {
-        let (lambda, mu) = crate::fem::elasticity::lame(1.0, self.params.nu);
-        for (k, tet) in self.mesh.tets.iter().enumerate() {
-            if self.part.tet_rank[k] as usize != self.rank {
-                continue;
-            }
-            let ke = crate::fem::elasticity::elasticity_stiffness(&crate::solid::assembly::tet_vertices(self.mesh, tet), lambda, mu);
+        crate::solid::assembly::add_stiffness(j, self.mesh, self.part, self.rank, self.params.nu, |tet| {
             let mut idx = [-1i32; 30];
             for (i, &n) in tet.iter().enumerate() {
                 idx[3 * i..3 * i + 3].copy_from_slice(&self.layout.u[n as usize]);
             }
-            j.add_values(&idx, &idx, ke.as_flattened())?;
-        }
-        Ok(())
+            idx
+        })
     }
 
     /// The constant coupling blocks: c M in the U_y rows and the load-balance row.
@@ -410,7 +377,7 @@ impl Problem for EhlSystem<'_> {
                 let c = self.mesh.nodes[worst_at];
                 eprintln!("EHL_DEBUG |F_U| = {:.3e} |F_P| = {:.3e} |F_H0| = {:.3e}; worst P row {:.3e} at ({:.3}, {:.3}) P = {:.4} H = {:.4}",
                     nu.sqrt(), np.sqrt(), all[self.layout.h0 as usize].abs(), worst, c[0], c[2], x[self.layout.p[worst_at] as usize],
-                    x[self.layout.h0 as usize] + 0.5 * (c[0] * c[0] + c[2] * c[2]) - x[self.layout.u[worst_at][1] as usize]);
+                    self.layout.film(self.mesh, x, worst_at as u32));
             }
         }
         Ok(Eval::Ok)
@@ -428,9 +395,7 @@ impl Problem for EhlSystem<'_> {
         let mut at = [0.0; 4];
         for &n in &self.mesh.contact_nodes {
             let c = self.mesh.nodes[n as usize];
-            let d = self.layout.u[n as usize][1];
-            let (uy, duy) = if d < 0 { (0.0, 0.0) } else { (x[d as usize], y[d as usize]) };
-            let h = x[self.layout.h0 as usize] + 0.5 * (c[0] * c[0] + c[2] * c[2]) - uy;
+            let (h, duy) = (self.layout.film(self.mesh, x, n), self.layout.uy(y, n));
             // x_new = x - y: H_new = H - (dh0 - duy)
             let dh = dh0 - duy;
             if dh > 0.0 && h > 0.0 && (1.0 - FILM_KEEP) * h / dh < s {

@@ -26,6 +26,15 @@ pub fn tet_vertices(mesh: &Mesh, tet: &[u32; 10]) -> [[f64; 3]; 4] {
 pub fn assemble_stiffness(comm: ffi::MPI_Comm, mesh: &Mesh, part: &Partition, dofs: &DofMap, rank: usize, nu: f64) -> Result<Matrix> {
     let (d_nnz, o_nnz) = preallocation(mesh, part, dofs, rank);
     let a = Matrix::new_aij(comm, dofs.local(rank), &d_nnz, &o_nnz)?;
+    add_stiffness(&a, mesh, part, rank, nu, |tet| dofs.tet_dofs(tet))?;
+    a.assemble()?;
+    a.set_symmetric(true)?;
+    Ok(a)
+}
+
+/// Adds the element stiffness matrices of this rank's tetrahedra into `a`, with the 30
+/// global indices of each element given by `index` (-1 for constrained components).
+pub fn add_stiffness(a: &Matrix, mesh: &Mesh, part: &Partition, rank: usize, nu: f64, index: impl Fn(&[u32; 10]) -> [i32; 30]) -> Result<()> {
     let (lambda, mu) = fem::elasticity::lame(1.0, nu);
     let mut ke = [0.0; 900];
     for (k, tet) in mesh.tets.iter().enumerate() {
@@ -33,12 +42,10 @@ pub fn assemble_stiffness(comm: ffi::MPI_Comm, mesh: &Mesh, part: &Partition, do
             continue;
         }
         fem::elasticity::elasticity_stiffness_flat(&tet_vertices(mesh, tet), lambda, mu, &mut ke);
-        let idx = dofs.tet_dofs(tet);
+        let idx = index(tet);
         a.add_values(&idx, &idx, &ke)?;
     }
-    a.assemble()?;
-    a.set_symmetric(true)?;
-    Ok(a)
+    Ok(())
 }
 
 /// Assembles the load vector of a normal pressure on the contact face:
