@@ -10,7 +10,8 @@
 //! film step limiter.
 use super::layout::Layout;
 use super::prealloc::preallocation;
-use super::system::{EhlParams, EhlSystem, Lubricant};
+use super::condensed::CondensedSystem;
+use super::system::{EhlParams, EhlProblem, EhlSystem, Lubricant};
 use crate::app::Context;
 use crate::case::Scene;
 use crate::mesh::{Mesh, Partition};
@@ -68,20 +69,117 @@ fn dry_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &Part
     u.gather_all()
 }
 
-/// Builds and solves the EHL system of the scene on the given mesh.
+/// EHL parameters of the scene (dimensionless).
+fn ehl_params(scene: &Scene, nu: f64, half: bool) -> EhlParams {
+    let scales = scene.scales();
+    let kin = scene.kinematics().expect("lubricated scene");
+    let (a, ue) = (scales.a, scene.operating.entrainment_speed.unwrap());
+    EhlParams {
+        lambda_bar: lambda_bar(scene),
+        traction: assembly::traction_factor(nu),
+        load: if half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 },
+        penalty: if scene.effects.cavitation == crate::case::CavitationModel::Penalty { scene.reynolds.penalty } else { 0.0 },
+        stabilisation: crate::reynolds::element::Stabilisation {
+            supg: scene.reynolds.stabilisation == crate::case::Stabilisation::Supg,
+            delta: 1.0,
+            id: scene.reynolds.artificial_diffusion,
+        },
+        velocity: Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue]),
+        nu,
+    }
+}
+
+/// Estimated dimensionless central film (Hamrock-Dowson), at least 0.02.
+fn hc_guess(scene: &Scene) -> f64 {
+    (scene.hamrock_dowson().map(|hd| hd.central_film_thickness()).unwrap_or(0.0) / scene.scales().film_scale()).max(0.02)
+}
+
+/// H0 of the start: the estimated central film over the dry deflection at the centre,
+/// raised if needed so that the starting film is positive everywhere (a coarse mesh's dry
+/// deflection is not flat in the contact). `uy` gives U_y at a contact node.
+fn start_h0(scene: &Scene, mesh: &Mesh, uy: &dyn Fn(u32) -> f64) -> Result<f64, String> {
+    let hc = hc_guess(scene);
+    let centre = mesh.locate_contact(0.0, 0.0).ok_or("contact centre not on the contact face")?;
+    let uy_centre = crate::fem::p2_tri_eval(&mesh.contact_tris[centre.0].map(uy), centre.1);
+    let min_gap = mesh.contact_nodes.iter().map(|&n| Layout::gap(mesh.nodes[n as usize]) - uy(n)).fold(f64::INFINITY, f64::min);
+    Ok((hc + uy_centre).max(0.5 * hc - min_gap))
+}
+
+/// Builds and solves the EHL system of the scene on the given mesh. The elastic block is
+/// condensed onto the contact face unless `EHL_MONOLITHIC` is set (developer switch).
 #[allow(clippy::too_many_arguments)]
 pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
+    set_newton_defaults().map_err(|e| e.to_string())?;
+    if std::env::var_os("EHL_MONOLITHIC").is_some() {
+        petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
+        solve_monolithic(ctx, scene, mesh, part, dofs, layout, half)
+    } else {
+        // The condensed Jacobian is dense: MUMPS's PORD ordering rejects it, AMD is fine.
+        petsc::options::set_default("-mat_mumps_icntl_7", "0").map_err(|e| e.to_string())?;
+        petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
+        solve_condensed(ctx, scene, mesh, layout, half)
+    }
+}
+
+/// The condensed path: face compliance once, then Newton on (P, H0).
+fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
+    let pe = |e: petsc::PetscError| e.to_string();
+    let comm = petsc::comm_world();
+    let eq = scene.equivalent_solid();
+    let t0 = std::time::Instant::now();
+    let p_nodes: Vec<u32> = mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect();
+    let comp = crate::solid::condense::face_compliance(&ctx.world, mesh, eq.nu, assembly::traction_factor(eq.nu), &p_nodes).map_err(pe)?;
+    ctx.log(format!(
+        "elastic block condensed onto the contact face: {} elastic unknowns -> {} face nodes x {} pressure nodes ({:.2} s)",
+        comp.elastic_unknowns,
+        comp.rows.len(),
+        comp.cols.len(),
+        comp.seconds
+    ));
+    let mut system = CondensedSystem::new(mesh, &comp, ctx.size, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene));
+    let cl = system.layout.clone();
+    // Start: Hertz pressure and its (condensed) deflection.
+    let mut x0 = vec![0.0; cl.total()];
+    for (j, &n) in comp.cols.iter().enumerate() {
+        let c = mesh.nodes[n as usize];
+        x0[j] = hertz_load::hertz_pressure(c[0], c[2]);
+    }
+    let uy0 = system.uy(&x0);
+    x0[cl.h0()] = start_h0(scene, mesh, &|n| uy0[cl.face_index[n as usize] as usize])?;
+    let (d_nnz, o_nnz) = system.preallocation();
+    let j = Matrix::new_aij(comm, cl.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?;
+    let assembly_s = t0.elapsed().as_secs_f64();
+    let t1 = std::time::Instant::now();
+    let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);
+    ctx.log(format!("Newton from the Hertz start: {} unknowns ({} P, 1 H0), dense Jacobian", cl.total(), cl.n_p));
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, &j, (lo, hi), cl.local(ctx.rank))?;
+    let solve_s = t1.elapsed().as_secs_f64();
+    // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
+    let uy = system.uy(&out.x);
+    let mut x = vec![0.0; layout.total()];
+    for (j, &n) in comp.cols.iter().enumerate() {
+        x[layout.p[n as usize] as usize] = out.x[j];
+    }
+    for (i, &n) in comp.rows.iter().enumerate() {
+        let d = layout.u[n as usize][1];
+        if d >= 0 {
+            x[d as usize] = uy[i];
+        }
+    }
+    x[layout.h0 as usize] = out.x[cl.h0()];
+    Ok(EhlSolution { x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s })
+}
+
+/// The monolithic path: U, P and H0 in one sparse system.
+fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
     let k = assembly::assemble_stiffness(comm, mesh, part, dofs, ctx.rank, eq.nu).map_err(pe)?;
-    petsc::ksp::set_direct_solver_defaults("").map_err(pe)?;
     let u_dry = dry_start(comm, ctx, mesh, part, dofs, &k, eq.nu).map_err(pe)?;
 
     // Initial iterate: dry displacement, Hertz pressure, H0 from Hamrock-Dowson's hc.
-    let scales = scene.scales();
-    let hc_guess = (scene.hamrock_dowson().map(|hd| hd.central_film_thickness()).unwrap_or(0.0) / scales.film_scale()).max(0.02);
     let mut x0 = vec![0.0; layout.total()];
     for n in 0..mesh.nodes.len() {
         for c in 0..3 {
@@ -101,77 +199,68 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
             *v = 0.0;
         }
     }
-    let centre = mesh.locate_contact(0.0, 0.0).ok_or("contact centre not on the contact face")?;
-    let uy_centre = crate::fem::p2_tri_eval(&mesh.contact_tris[centre.0].map(|n| layout.uy(&x0, n)), centre.1);
-    // H0 from the estimated central film, raised if needed so that the starting film is
-    // positive everywhere (a coarse mesh's dry deflection is not flat in the contact).
-    let min_gap = mesh
-        .contact_nodes
-        .iter()
-        .map(|&n| Layout::gap(mesh.nodes[n as usize]) - layout.uy(&x0, n))
-        .fold(f64::INFINITY, f64::min);
-    x0[layout.h0 as usize] = (hc_guess + uy_centre).max(0.5 * hc_guess - min_gap);
-
-    let kin = scene.kinematics().expect("lubricated scene");
-    let (a, ue) = (scales.a, scene.operating.entrainment_speed.unwrap());
-    let params = EhlParams {
-        lambda_bar: lambda_bar(scene),
-        traction: assembly::traction_factor(eq.nu),
-        load: if half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 },
-        penalty: if scene.effects.cavitation == crate::case::CavitationModel::Penalty { scene.reynolds.penalty } else { 0.0 },
-        stabilisation: crate::reynolds::element::Stabilisation {
-            supg: scene.reynolds.stabilisation == crate::case::Stabilisation::Supg,
-            delta: 1.0,
-            id: scene.reynolds.artificial_diffusion,
-        },
-        velocity: Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue]),
-        nu: eq.nu,
-    };
+    x0[layout.h0 as usize] = start_h0(scene, mesh, &|n| layout.uy(&x0, n))?;
     let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank);
     let j = Matrix::new_aij(comm, layout.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?;
-    let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, params, lubricant(scene), k).map_err(pe)?;
+    let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene), k).map_err(pe)?;
     let assembly_s = t0.elapsed().as_secs_f64();
-
     let t1 = std::time::Instant::now();
-    let x = Vector::new(comm, layout.local(ctx.rank)).map_err(pe)?;
-    let (lo, hi) = (layout.ranges[ctx.rank], layout.ranges[ctx.rank + 1]);
-    x.set_local_values(&x0[lo..hi]).map_err(pe)?;
-    set_newton_defaults().map_err(pe)?;
-    let snes = Snes::new(comm, "").map_err(pe)?;
     ctx.log(format!("Newton from the Hertz start: {} unknowns ({} U, {} P, 1 H0)", layout.total(), layout.counts().0, layout.counts().1));
-    if std::env::var_os("EHL_NO_ROW_SCALING").is_none() {
-        system.scale_rows(&x0).map_err(pe)?;
-    }
     if std::env::var_os("EHL_CHECK_JACOBIAN").is_some() {
+        if std::env::var_os("EHL_NO_ROW_SCALING").is_none() {
+            system.scale_rows(&x0).map_err(pe)?;
+        }
         for (r, c, e) in check_jacobian(&mut system, layout, ctx.rank, &x0, &j).map_err(pe)? {
             ctx.log(format!("Jacobian check: rows {r:2} cols {c:2}: max |J v - FD| / max |J v| = {e:.3e}"));
         }
     }
+    let (lo, hi) = (layout.ranges[ctx.rank], layout.ranges[ctx.rank + 1]);
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, &j, (lo, hi), layout.local(ctx.rank))?;
+    let solve_s = t1.elapsed().as_secs_f64();
+    Ok(EhlSolution { x: out.x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s })
+}
+
+/// Outcome of [`newton_with_continuation`].
+struct NewtonOutcome {
+    x: Vec<f64>,
+    report: SolveReport,
+    newton_total: usize,
+    steps: Vec<String>,
+}
+
+/// Newton from `x0` at the scene's operating point; if that fails, a continuation in load
+/// from a light load up to the scene's. Returns the converged iterate (gathered) or an
+/// error naming the path taken.
+fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], j: &Matrix, (lo, hi): (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
+    let pe = |e: petsc::PetscError| e.to_string();
+    let comm = petsc::comm_world();
+    let x = Vector::new(comm, local).map_err(pe)?;
+    let snes = Snes::new(comm, "").map_err(pe)?;
+    let scaling = std::env::var_os("EHL_NO_ROW_SCALING").is_none();
+    let solve_at = |load: f64, system: &mut dyn EhlProblem, start: &[f64]| -> Result<SolveReport, String> {
+        let mut sc = scene.clone();
+        sc.operating.load = load;
+        system.set_operating(lambda_bar(&sc), lubricant(&sc));
+        x.set_local_values(&start[lo..hi]).map_err(pe)?;
+        if scaling {
+            system.scale_rows(start).map_err(pe)?;
+        }
+        snes.solve(system, &x, j).map_err(pe)
+    };
     // 1. Plain Newton from the Hertz start at the scene's operating point.
-    let report = snes.solve(&mut system, &x, &j).map_err(pe)?;
-    let mut steps = vec![format!("Newton from the Hertz start at L = {} N: {} ({} iterations)", scene.operating.load, report.reason, report.iterations)];
+    let target = scene.operating.load;
+    let report = solve_at(target, system, x0)?;
+    let mut steps = vec![format!("Newton from the Hertz start at L = {} N: {} ({} iterations)", target, report.reason, report.iterations)];
     ctx.log(&steps[0]);
     let mut newton_total = report.iterations;
     let mut last = report;
     // 2. If it failed: continuation in load. A lighter load is a milder problem in Hertz
     //    units (smaller M, alpha p_H); each converged state starts the next, heavier one.
     if !last.converged {
-        let target = scene.operating.load;
-        let solve_at = |load: f64, system: &mut EhlSystem, start: &[f64]| -> Result<SolveReport, String> {
-            let mut sc = scene.clone();
-            sc.operating.load = load;
-            system.set_operating(lambda_bar(&sc), lubricant(&sc));
-            x.set_local_values(&start[lo..hi]).map_err(pe)?;
-            if std::env::var_os("EHL_NO_ROW_SCALING").is_none() {
-                system.scale_rows(start).map_err(pe)?;
-            }
-            snes.solve(system, &x, &j).map_err(pe)
-        };
-        // Find a light load that converges from the Hertz start.
         let mut load = target / 8.0;
         let mut state: Option<Vec<f64>> = None;
         while load >= target / 64.0 {
-            let r = solve_at(load, &mut system, &x0)?;
+            let r = solve_at(load, system, x0)?;
             newton_total += r.iterations;
             steps.push(format!("continuation: Hertz start at L = {load:.4} N: {} ({} iterations)", r.reason, r.iterations));
             ctx.log(steps.last().unwrap());
@@ -188,7 +277,7 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
         let mut ratio: f64 = 2.0;
         while load < target {
             let next = (load * ratio).min(target);
-            let r = solve_at(next, &mut system, &state)?;
+            let r = solve_at(next, system, &state)?;
             newton_total += r.iterations;
             steps.push(format!("continuation: L = {next:.4} N: {} ({} iterations)", r.reason, r.iterations));
             ctx.log(steps.last().unwrap());
@@ -204,35 +293,19 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
                 }
             }
         }
-        if load < target {
-            x.set_local_values(&state[lo..hi]).map_err(pe)?;
-        }
     }
-    let report = last;
-    let solve_s = t1.elapsed().as_secs_f64();
-    if !report.converged && std::env::var_os("EHL_DEBUG").is_some() && ctx.rank == 0 {
-        let xs = x.gather_all().map_err(pe)?;
-        let f = super::post::FieldsOnFace::new(mesh, layout, &xs);
-        let mut t = String::from("x,z,p,h\n");
-        for r in f.profile([mesh.spec.contact.x0, 0.0], [mesh.spec.contact.x1, 0.0], 241) {
-            t.push_str(&format!("{},{},{},{}\n", r[0], r[1], r[2], r[3]));
-        }
-        let _ = std::fs::write(ctx.out_dir.join("debug_profile_z0.csv"), t);
-    } else if !report.converged && std::env::var_os("EHL_DEBUG").is_some() {
-        x.gather_all().map_err(pe)?;
-    }
-    if !report.converged {
+    if !last.converged {
         return Err(format!(
             "Newton did not converge: {} after {} iterations (residual norm {:.3e}){}; path: {}",
-            report.reason,
-            report.iterations,
-            report.residual_norm,
-            report.domain_error.as_ref().map(|d| format!("; last domain error: {d}")).unwrap_or_default(),
+            last.reason,
+            last.iterations,
+            last.residual_norm,
+            last.domain_error.as_ref().map(|d| format!("; last domain error: {d}")).unwrap_or_default(),
             steps.join("; ")
         ));
     }
     let xs = x.gather_all().map_err(pe)?;
-    Ok(EhlSolution { x: xs, report, newton_total, steps, assembly_s, solve_s })
+    Ok(NewtonOutcome { x: xs, report: last, newton_total, steps })
 }
 
 /// Newton defaults (overridable by PETSc options).

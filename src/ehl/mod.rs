@@ -3,5 +3,6 @@
 pub mod layout;
 pub mod prealloc;
 pub mod system;
+pub mod condensed;
 pub mod driver;
 pub mod post;

@@ -193,49 +193,11 @@ impl<'a> EhlSystem<'a> {
         })
     }
 
-    /// Scales each Reynolds row by the inverse of its Jacobian diagonal at `x` (held constant
-    /// afterwards, so the Jacobian stays exact and the solution unchanged). The rows' natural
-    /// sizes differ by ten orders of magnitude (eps ~ 1e4 at the inlet, ~1e-9 in the
-    /// contact); scaled, the residual norm that the line search watches weighs them alike.
-    pub fn scale_rows(&mut self, x: &[f64]) -> Result<()> {
-        let comm = crate::petsc::comm_world();
-        let diag = Vector::new(comm, self.layout.local(self.rank))?;
-        diag.set_all(0.0)?;
-        let fluid = self.fluid();
-        for e in &self.elements {
-            let p = self.element_pressure(x, e);
-            let h = self.element_film(x, e);
-            let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid, &self.params.stabilisation);
-            let rows: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
-            let d: [f64; 6] = std::array::from_fn(|i| out.dr_dp[i][i].abs());
-            diag.set_values(&rows, &d, true)?;
-        }
-        diag.assemble()?;
-        let all = diag.gather_all()?;
-        self.row_scale.clear();
-        for n in 0..self.mesh.nodes.len() {
-            let d = self.layout.p[n];
-            if d >= 0 {
-                let v = all[d as usize] + self.params.penalty * 1e-6;
-                self.row_scale.insert(d, if v > 0.0 { 1.0 / v } else { 1.0 });
-            }
-        }
-        Ok(())
-    }
-
     fn scale_of(&self, row: i32) -> f64 {
         if row < 0 {
             return 0.0;
         }
         *self.row_scale.get(&row).unwrap_or(&1.0)
-    }
-
-    /// Changes the operating point seen by the Reynolds rows (for continuation): the
-    /// speed parameter lambda_bar and the dimensionless lubricant laws. The elastic rows do
-    /// not depend on it.
-    pub fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant) {
-        self.params.lambda_bar = lambda_bar;
-        self.lubricant = lubricant;
     }
 
     /// Nodal film thickness H = H0 + gap - U_y at the 6 nodes of a contact element.
@@ -288,6 +250,53 @@ impl<'a> EhlSystem<'a> {
         }
         Ok(())
     }
+}
+
+/// What the Newton driver needs of an EHL problem besides residual and Jacobian.
+pub trait EhlProblem: Problem {
+    /// Changes the operating point seen by the Reynolds rows (for continuation): the
+    /// speed parameter lambda_bar and the dimensionless lubricant laws. The elastic rows do
+    /// not depend on it.
+    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant);
+    /// Scales each Reynolds row by the inverse of its Jacobian diagonal at `x` (held constant
+    /// afterwards, so the Jacobian stays exact and the solution unchanged). The rows' natural
+    /// sizes differ by ten orders of magnitude (eps ~ 1e4 at the inlet, ~1e-9 in the
+    /// contact); scaled, the residual norm that the line search watches weighs them alike.
+    fn scale_rows(&mut self, x: &[f64]) -> Result<()>;
+}
+
+impl EhlProblem for EhlSystem<'_> {
+    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant) {
+        self.params.lambda_bar = lambda_bar;
+        self.lubricant = lubricant;
+    }
+
+    fn scale_rows(&mut self, x: &[f64]) -> Result<()> {
+        let comm = crate::petsc::comm_world();
+        let diag = Vector::new(comm, self.layout.local(self.rank))?;
+        diag.set_all(0.0)?;
+        let fluid = self.fluid();
+        for e in &self.elements {
+            let p = self.element_pressure(x, e);
+            let h = self.element_film(x, e);
+            let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid, &self.params.stabilisation);
+            let rows: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
+            let d: [f64; 6] = std::array::from_fn(|i| out.dr_dp[i][i].abs());
+            diag.set_values(&rows, &d, true)?;
+        }
+        diag.assemble()?;
+        let all = diag.gather_all()?;
+        self.row_scale.clear();
+        for n in 0..self.mesh.nodes.len() {
+            let d = self.layout.p[n];
+            if d >= 0 {
+                let v = all[d as usize] + self.params.penalty * 1e-6;
+                self.row_scale.insert(d, if v > 0.0 { 1.0 / v } else { 1.0 });
+            }
+        }
+        Ok(())
+    }
+
 }
 
 impl Problem for EhlSystem<'_> {

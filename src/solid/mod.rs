@@ -1,5 +1,6 @@
 //! The equivalent elastic solid (physics.md section 6): DOF numbering, assembly of the
 //! P2 elasticity system and of contact-face pressure loads.
 pub mod assembly;
+pub mod condense;
 pub mod dofmap;
 pub mod hertz_load;

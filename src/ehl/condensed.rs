@@ -1,0 +1,327 @@
+//! The EHL system with the elastic block condensed onto the contact face
+//! (see [`crate::solid::condense`]): unknowns P at the Reynolds nodes and H0 only,
+//!   Reynolds:      R(P, H(P, H0)) + penalty(P) = 0,   H = H0 + (X^2 + Z^2)/2 + C P
+//!   load balance:  integral of P - W = 0.
+//! It has the same solution as the monolithic system of [`super::system`] (exact
+//! elimination of U). The Jacobian is dense in P (every pressure deflects every face
+//! node): dR/dP + dR/dH C, assembled row by row into a dense-pattern AIJ matrix that MUMPS
+//! factorises; its size is set by the Reynolds mesh alone, not by the 3D mesh.
+use super::system::{p2_tri_weights, penalty_law, tri_area, EhlParams, Lubricant, CAVITATION_SMOOTHING};
+use super::system::EhlProblem;
+use crate::mesh::Mesh;
+use crate::petsc::snes::{Eval, Problem};
+use crate::petsc::{Matrix, Result, Vector};
+use crate::reynolds::element::{reynolds_element, Fluid};
+use crate::solid::condense::Compliance;
+
+/// Numbering of the condensed unknowns: P in `comp.cols` order, then H0; rank r owns
+/// `ranges[r]..ranges[r + 1]` (the last rank owns H0).
+#[derive(Debug, Clone)]
+pub struct CondensedLayout {
+    pub n_p: usize,
+    pub ranges: Vec<usize>,
+    /// Per mesh node: its pressure unknown or -1.
+    pub p_index: Vec<i32>,
+    /// Per mesh node: its row in the compliance (face index) or -1.
+    pub face_index: Vec<i32>,
+}
+
+impl CondensedLayout {
+    pub fn new(mesh: &Mesh, comp: &Compliance, nranks: usize) -> Self {
+        let n_p = comp.cols.len();
+        let mut p_index = vec![-1i32; mesh.nodes.len()];
+        for (j, &n) in comp.cols.iter().enumerate() {
+            p_index[n as usize] = j as i32;
+        }
+        let mut face_index = vec![-1i32; mesh.nodes.len()];
+        for (i, &n) in comp.rows.iter().enumerate() {
+            face_index[n as usize] = i as i32;
+        }
+        let total = n_p + 1;
+        let ranges = (0..=nranks).map(|r| if r == nranks { total } else { r * n_p / nranks }).collect();
+        CondensedLayout { n_p, ranges, p_index, face_index }
+    }
+    pub fn total(&self) -> usize {
+        self.n_p + 1
+    }
+    pub fn local(&self, rank: usize) -> usize {
+        self.ranges[rank + 1] - self.ranges[rank]
+    }
+    pub fn h0(&self) -> usize {
+        self.n_p
+    }
+}
+
+struct Element {
+    /// Face index of the 6 nodes.
+    face: [usize; 6],
+    /// Pressure unknown of the 6 nodes (-1 on the Dirichlet edges).
+    p: [i32; 6],
+    verts: [[f64; 2]; 3],
+    vel: [[f64; 2]; 3],
+    area: f64,
+    /// Touches a row this rank owns.
+    mine: bool,
+}
+
+/// The condensed EHL problem on one rank (all data replicated; rows distributed).
+pub struct CondensedSystem<'a> {
+    pub comp: &'a Compliance,
+    pub layout: CondensedLayout,
+    pub rank: usize,
+    pub params: EhlParams,
+    pub lubricant: Lubricant,
+    elements: Vec<Element>,
+    /// (pressure unknown, nodal area) of owned pressure rows.
+    penalty_nodes: Vec<(usize, f64)>,
+    /// Rigid gap at each face node.
+    gap: Vec<f64>,
+    row_scale: Vec<f64>,
+    pub residual_evals: usize,
+    pub jacobian_evals: usize,
+    pub step_limits: Vec<f64>,
+}
+
+impl<'a> CondensedSystem<'a> {
+    pub fn new(mesh: &Mesh, comp: &'a Compliance, nranks: usize, rank: usize, params: EhlParams, lubricant: Lubricant) -> Self {
+        let layout = CondensedLayout::new(mesh, comp, nranks);
+        let (lo, hi) = (layout.ranges[rank], layout.ranges[rank + 1].min(layout.n_p));
+        let mut node_area = vec![0.0; comp.rows.len()];
+        let mut elements = Vec::new();
+        for tri in &mesh.contact_tris {
+            let xz = |n: u32| {
+                let c = mesh.nodes[n as usize];
+                [c[0], c[2]]
+            };
+            let verts = [xz(tri[0]), xz(tri[1]), xz(tri[2])];
+            let face = tri.map(|n| layout.face_index[n as usize] as usize);
+            let p = tri.map(|n| layout.p_index[n as usize]);
+            let area = tri_area(&verts);
+            for &f in &face {
+                node_area[f] += area / 6.0;
+            }
+            let mine = p.iter().any(|&d| d >= 0 && (d as usize) >= lo && (d as usize) < hi);
+            elements.push(Element {
+                face,
+                p,
+                verts,
+                vel: verts.map(|v| (params.velocity)(v[0], v[1])),
+                area,
+                mine,
+            });
+        }
+        let penalty_nodes = (lo..hi).map(|j| (j, node_area[layout.face_index[comp.cols[j] as usize] as usize])).collect();
+        let gap = comp.rows.iter().map(|&n| super::layout::Layout::gap(mesh.nodes[n as usize])).collect();
+        let row_scale = vec![1.0; layout.total()];
+        CondensedSystem {
+            comp,
+            layout,
+            rank,
+            params,
+            lubricant,
+            elements,
+            penalty_nodes,
+            gap,
+            row_scale,
+            residual_evals: 0,
+            jacobian_evals: 0,
+            step_limits: Vec::new(),
+        }
+    }
+
+    fn owned(&self) -> (usize, usize) {
+        (self.layout.ranges[self.rank], self.layout.ranges[self.rank + 1])
+    }
+
+    /// Film H at every face node for the iterate x = (P, H0).
+    pub fn film(&self, x: &[f64]) -> Vec<f64> {
+        let h0 = x[self.layout.h0()];
+        let uy = self.comp.apply(&x[..self.layout.n_p]);
+        uy.iter().zip(&self.gap).map(|(u, g)| h0 + g - u).collect()
+    }
+
+    /// U_y at every face node.
+    pub fn uy(&self, x: &[f64]) -> Vec<f64> {
+        self.comp.apply(&x[..self.layout.n_p])
+    }
+
+    fn fluid(&self) -> Fluid<'_> {
+        Fluid {
+            eta: &*self.lubricant.eta,
+            rho: &*self.lubricant.rho,
+            d2eta: &*self.lubricant.d2eta,
+            d2rho: &*self.lubricant.d2rho,
+            lambda_bar: self.params.lambda_bar,
+        }
+    }
+
+    fn element_p(x: &[f64], e: &Element) -> [f64; 6] {
+        e.p.map(|d| if d >= 0 { x[d as usize] } else { 0.0 })
+    }
+
+    /// Dense local preallocation: every owned row is full.
+    pub fn preallocation(&self) -> (Vec<i32>, Vec<i32>) {
+        let nl = self.layout.local(self.rank);
+        let n = self.layout.total();
+        (vec![nl as i32; nl], vec![(n - nl) as i32; nl])
+    }
+}
+
+impl EhlProblem for CondensedSystem<'_> {
+    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant) {
+        self.params.lambda_bar = lambda_bar;
+        self.lubricant = lubricant;
+    }
+
+    /// Row scaling as in the monolithic system: each Reynolds row by the inverse of its
+    /// dR/dP diagonal at `x` (constant afterwards).
+    fn scale_rows(&mut self, x: &[f64]) -> Result<()> {
+        let h = self.film(x);
+        let fluid = self.fluid();
+        let mut diag = vec![0.0; self.layout.total()];
+        for e in self.elements.iter().filter(|e| e.mine) {
+            let p = Self::element_p(x, e);
+            let he = e.face.map(|f| h[f]);
+            let out = reynolds_element(&e.verts, &p, &he, &e.vel, &fluid, &self.params.stabilisation);
+            for i in 0..6 {
+                if e.p[i] >= 0 {
+                    diag[e.p[i] as usize] += out.dr_dp[i][i];
+                }
+            }
+        }
+        for (j, d) in diag.iter().enumerate().take(self.layout.n_p) {
+            let v = d.abs() + self.params.penalty * 1e-6;
+            self.row_scale[j] = if v > 0.0 { 1.0 / v } else { 1.0 };
+        }
+        Ok(())
+    }
+}
+
+impl Problem for CondensedSystem<'_> {
+    fn residual(&mut self, x: &[f64], f: &Vector) -> Result<Eval> {
+        self.residual_evals += 1;
+        let h = self.film(x);
+        // Every rank holds the same iterate and the same compliance: the domain check
+        // agrees everywhere without communication.
+        if let Some(k) = h.iter().position(|v| !(*v > 0.0) || !v.is_finite()) {
+            return Ok(Eval::Domain(format!("film thickness H = {:.3e} at face node {}", h[k], self.comp.rows[k])));
+        }
+        let (lo, hi) = self.owned();
+        let mut r = vec![0.0; hi - lo];
+        let fluid = self.fluid();
+        let mut load = 0.0;
+        for e in &self.elements {
+            let p = Self::element_p(x, e);
+            let w = p2_tri_weights(e.area);
+            load += (0..6).map(|k| w[k] * p[k]).sum::<f64>();
+            if !e.mine {
+                continue;
+            }
+            let he = e.face.map(|f| h[f]);
+            let out = reynolds_element(&e.verts, &p, &he, &e.vel, &fluid, &self.params.stabilisation);
+            for i in 0..6 {
+                let d = e.p[i];
+                if d >= 0 && (d as usize) >= lo && (d as usize) < hi {
+                    r[d as usize - lo] += out.r[i];
+                }
+            }
+        }
+        for &(j, area) in &self.penalty_nodes {
+            r[j - lo] += self.params.penalty * area * penalty_law(x[j]).0;
+        }
+        for (i, v) in r.iter_mut().enumerate() {
+            *v *= self.row_scale[lo + i];
+        }
+        if hi > self.layout.n_p {
+            r[self.layout.h0() - lo] = load - self.params.load;
+        }
+        let idx: Vec<i32> = (lo as i32..hi as i32).collect();
+        f.set_values(&idx, &r, true)?;
+        Ok(Eval::Ok)
+    }
+
+    fn limit_step(&mut self, x: &[f64], y: &[f64]) -> Result<f64> {
+        const FILM_KEEP: f64 = 0.2;
+        if std::env::var_os("EHL_NO_LIMIT").is_some() {
+            return Ok(1.0);
+        }
+        let h = self.film(x);
+        let dh0 = y[self.layout.h0()];
+        let duy = self.comp.apply(&y[..self.layout.n_p]);
+        let mut s: f64 = 1.0;
+        for k in 0..h.len() {
+            // x_new = x - y: H_new = H - (dh0 - duy)
+            let dh = dh0 - duy[k];
+            if dh > 0.0 && h[k] > 0.0 && (1.0 - FILM_KEEP) * h[k] / dh < s {
+                s = (1.0 - FILM_KEEP) * h[k] / dh;
+            }
+        }
+        self.step_limits.push(s);
+        Ok(s)
+    }
+
+    fn jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
+        self.jacobian_evals += 1;
+        let (lo, hi) = self.owned();
+        let n = self.layout.total();
+        let np = self.layout.n_p;
+        let h = self.film(x);
+        let fluid = self.fluid();
+        let mut buf = vec![0.0; (hi - lo) * n];
+        for e in self.elements.iter().filter(|e| e.mine) {
+            let p = Self::element_p(x, e);
+            let he = e.face.map(|f| h[f]);
+            let out = reynolds_element(&e.verts, &p, &he, &e.vel, &fluid, &self.params.stabilisation);
+            for i in 0..6 {
+                let d = e.p[i];
+                if d < 0 || (d as usize) < lo || (d as usize) >= hi {
+                    continue;
+                }
+                let row = &mut buf[(d as usize - lo) * n..(d as usize - lo + 1) * n];
+                for k in 0..6 {
+                    if e.p[k] >= 0 {
+                        row[e.p[k] as usize] += out.dr_dp[i][k];
+                    }
+                    // H = H0 + gap - U_y with U_y = C P: dH/dP = -C, dH/dH0 = 1.
+                    let g = out.dr_dh[i][k];
+                    if g != 0.0 {
+                        let crow = &self.comp.c[e.face[k] * np..(e.face[k] + 1) * np];
+                        for (a, c) in row[..np].iter_mut().zip(crow) {
+                            *a -= g * c;
+                        }
+                        row[np] += g;
+                    }
+                }
+            }
+        }
+        for &(jn, area) in &self.penalty_nodes {
+            let (_, dv) = penalty_law(x[jn]);
+            let dv = dv.max(if CAVITATION_SMOOTHING > 0.0 { 0.0 } else { 1.0 });
+            buf[(jn - lo) * n + jn] += self.params.penalty * area * dv;
+        }
+        for r in lo..hi.min(np) {
+            let s = self.row_scale[r];
+            for v in &mut buf[(r - lo) * n..(r - lo + 1) * n] {
+                *v *= s;
+            }
+        }
+        if hi > np {
+            // Load row: integral of P.
+            let row = &mut buf[(np - lo) * n..];
+            for e in &self.elements {
+                let w = p2_tri_weights(e.area);
+                for k in 0..6 {
+                    if e.p[k] >= 0 {
+                        row[e.p[k] as usize] += w[k];
+                    }
+                }
+            }
+        }
+        j.zero()?;
+        let cols: Vec<i32> = (0..n as i32).collect();
+        for r in lo..hi {
+            j.add_values(&[r as i32], &cols, &buf[(r - lo) * n..(r - lo + 1) * n])?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,187 @@
+//! Static condensation of the equivalent solid onto its contact face (exact, done once).
+//!
+//! The elastic block of the EHL system is linear and constant, and the Reynolds equation
+//! sees the solid only through U_y on the contact face. Eliminating every other
+//! displacement unknown gives the face compliance
+//! ```text
+//!   U_y(face) = C P,      C = -c S^{-1} M,
+//! ```
+//! where S is the Schur complement of the stiffness K onto the U_y unknowns of the face
+//! nodes, M (face nodes x pressure nodes) the P2 face mass matrix (integral N_i N_j) and
+//! c = E'/(pi E_eq) the traction factor. This is the same discrete model as the monolithic
+//! system (no approximation, only a different elimination order), as in Habchi's "exact
+//! model order reduction" of the full-system EHL approach.
+//!
+//! MUMPS computes S during one sparse factorisation of K (ICNTL(19)); PETSc only supports
+//! that sequentially, so rank 0 does it on the whole (replicated) mesh and broadcasts C.
+use super::assembly::assemble_stiffness;
+use super::dofmap::DofMap;
+use crate::mesh::{partition, Mesh};
+use crate::pcall;
+use crate::petsc::error::rust_error;
+use crate::petsc::{ffi, Result};
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+
+/// Face compliance: `c[i * cols.len() + j]` = U_y at face node `rows[i]` per unit P at
+/// pressure node `cols[j]` (dimensionless).
+pub struct Compliance {
+    /// Face nodes (mesh node ids), in `mesh.contact_nodes` order.
+    pub rows: Vec<u32>,
+    /// Pressure nodes (mesh node ids).
+    pub cols: Vec<u32>,
+    /// Row-major dense matrix, rows.len() x cols.len().
+    pub c: Vec<f64>,
+    /// Seconds spent (rank 0: assembly, factorisation with Schur complement, dense solve).
+    pub seconds: f64,
+    /// Unknowns of the eliminated elastic problem.
+    pub elastic_unknowns: usize,
+}
+
+impl Compliance {
+    /// U_y at every face node for the nodal pressures `p` (in `cols` order).
+    pub fn apply(&self, p: &[f64]) -> Vec<f64> {
+        let n = self.cols.len();
+        self.c.chunks_exact(n).map(|row| row.iter().zip(p).map(|(a, b)| a * b).sum()).collect()
+    }
+}
+
+/// Owned PETSc objects destroyed on drop.
+struct OwnedMat(ffi::Mat);
+impl Drop for OwnedMat {
+    fn drop(&mut self) {
+        if !self.0.is_null() {
+            unsafe { ffi::MatDestroy(&mut self.0) };
+        }
+    }
+}
+struct OwnedIs(ffi::IS);
+impl Drop for OwnedIs {
+    fn drop(&mut self) {
+        if !self.0.is_null() {
+            unsafe { ffi::ISDestroy(&mut self.0) };
+        }
+    }
+}
+
+/// The P2 face mass matrix B[i][j] = integral over the face of N_i N_j for face rows
+/// `rows` and pressure columns `cols` (dense, row-major).
+fn face_mass(mesh: &Mesh, rows: &[u32], cols: &[u32]) -> Vec<f64> {
+    let mut row_of = vec![-1i64; mesh.nodes.len()];
+    for (i, &n) in rows.iter().enumerate() {
+        row_of[n as usize] = i as i64;
+    }
+    let mut col_of = vec![-1i64; mesh.nodes.len()];
+    for (j, &n) in cols.iter().enumerate() {
+        col_of[n as usize] = j as i64;
+    }
+    let nc = cols.len();
+    let mut b = vec![0.0; rows.len() * nc];
+    for tri in &mesh.contact_tris {
+        let xz = |n: u32| {
+            let c = mesh.nodes[n as usize];
+            [c[0], c[2]]
+        };
+        let m = crate::ehl::system::p2_tri_mass(crate::ehl::system::tri_area(&[xz(tri[0]), xz(tri[1]), xz(tri[2])]));
+        for a in 0..6 {
+            let i = row_of[tri[a] as usize];
+            for bb in 0..6 {
+                let j = col_of[tri[bb] as usize];
+                if i >= 0 && j >= 0 {
+                    b[i as usize * nc + j as usize] += m[a][bb];
+                }
+            }
+        }
+    }
+    b
+}
+
+/// Computes the face compliance of the equivalent solid (Poisson ratio `nu`, traction
+/// factor `traction`) for the pressure nodes `cols`. Collective over `world`; the result
+/// is on every rank.
+pub fn face_compliance(world: &SimpleCommunicator, mesh: &Mesh, nu: f64, traction: f64, cols: &[u32]) -> Result<Compliance> {
+    let t0 = std::time::Instant::now();
+    let rows: Vec<u32> = mesh.contact_nodes.clone();
+    let (nr, nc) = (rows.len(), cols.len());
+    let mut c = vec![0.0; nr * nc];
+    let part = partition(mesh, 1);
+    let dofs = DofMap::new(mesh, &part, 1);
+    let mut status: i32 = 0;
+    if world.rank() == 0 {
+        let r = schur_compliance(mesh, &part, &dofs, nu, traction, &rows, cols);
+        match r {
+            Ok(v) => c = v,
+            Err(e) => {
+                status = 1;
+                eprintln!("ehl-petsc: face condensation failed on rank 0: {e}");
+            }
+        }
+    }
+    world.process_at_rank(0).broadcast_into(&mut status);
+    if status != 0 {
+        return Err(rust_error("static condensation of the elastic block failed on rank 0 (see its message)"));
+    }
+    world.process_at_rank(0).broadcast_into(&mut c[..]);
+    Ok(Compliance { rows, cols: cols.to_vec(), c, seconds: t0.elapsed().as_secs_f64(), elastic_unknowns: dofs.total() })
+}
+
+/// Rank 0's work: K on PETSC_COMM_SELF, MUMPS LU with the Schur complement on the face
+/// U_y unknowns, then C = -c S^{-1} M by a dense LAPACK solve.
+fn schur_compliance(mesh: &Mesh, part: &crate::mesh::Partition, dofs: &DofMap, nu: f64, traction: f64, rows: &[u32], cols: &[u32]) -> Result<Vec<f64>> {
+    let selfc = unsafe { ffi::RSMPI_COMM_SELF };
+    let t = std::time::Instant::now();
+    let k = assemble_stiffness(selfc, mesh, part, dofs, 0, nu)?;
+    let dbg = std::env::var_os("EHL_DEBUG").is_some();
+    if dbg { eprintln!("condense: K assembled {:.2} s", t.elapsed().as_secs_f64()); }
+    // K is symmetric positive definite (clamped base): MUMPS LDL^T without pivoting.
+    pcall!(ffi::MatSetOption(k.raw(), ffi::MatOption_MAT_SPD, ffi::PetscBool_PETSC_TRUE))?;
+    // Schur indices: the U_y unknowns of the face nodes (MUMPS keeps the given order).
+    let idx: Vec<i32> = rows.iter().map(|&n| dofs.node_dof[n as usize][1]).collect();
+    if idx.iter().any(|&d| d < 0) {
+        return Err(rust_error("a contact face node has a constrained U_y"));
+    }
+    let nr = rows.len();
+    let mut is = OwnedIs(std::ptr::null_mut());
+    pcall!(ffi::ISCreateGeneral(selfc, nr as i32, idx.as_ptr(), ffi::PetscCopyMode_PETSC_COPY_VALUES, &mut is.0))?;
+    let mut f = OwnedMat(std::ptr::null_mut());
+    pcall!(ffi::MatGetFactor(k.raw(), ffi::MATSOLVERMUMPS.as_ptr() as *const _, ffi::MatFactorType_MAT_FACTOR_CHOLESKY, &mut f.0))?;
+    pcall!(ffi::MatFactorSetSchurIS(f.0, is.0))?;
+    let mut info: ffi::MatFactorInfo = unsafe { std::mem::zeroed() };
+    pcall!(ffi::MatFactorInfoInitialize(&mut info))?;
+    pcall!(ffi::MatCholeskyFactorSymbolic(f.0, k.raw(), std::ptr::null_mut(), &info))?;
+    pcall!(ffi::MatCholeskyFactorNumeric(f.0, k.raw(), &info))?;
+    let mut s = OwnedMat(std::ptr::null_mut());
+    let mut st: ffi::MatFactorSchurStatus = 0;
+    pcall!(ffi::MatFactorCreateSchurComplement(f.0, &mut s.0, &mut st))?;
+    if dbg { eprintln!("condense: factor + Schur {:.2} s", t.elapsed().as_secs_f64()); }
+    drop(f);
+    drop(k);
+    // B = -c M (column-major for PETSc's dense matrix), then solve S X = B in place.
+    let m = face_mass(mesh, rows, cols);
+    let nc = cols.len();
+    let mut bcol = vec![0.0; nr * nc];
+    for i in 0..nr {
+        for j in 0..nc {
+            bcol[j * nr + i] = -traction * m[i * nc + j];
+        }
+    }
+    let mut b = OwnedMat(std::ptr::null_mut());
+    pcall!(ffi::MatCreateSeqDense(selfc, nr as i32, nc as i32, bcol.as_mut_ptr(), &mut b.0))?;
+    let mut x = OwnedMat(std::ptr::null_mut());
+    pcall!(ffi::MatCreateSeqDense(selfc, nr as i32, nc as i32, std::ptr::null_mut(), &mut x.0))?;
+    pcall!(ffi::MatLUFactor(s.0, std::ptr::null_mut(), std::ptr::null_mut(), &info))?;
+    pcall!(ffi::MatMatSolve(s.0, b.0, x.0))?;
+    let mut ptr: *const f64 = std::ptr::null();
+    pcall!(ffi::MatDenseGetArrayRead(x.0, &mut ptr))?;
+    let xs = unsafe { std::slice::from_raw_parts(ptr, nr * nc) };
+    let mut c = vec![0.0; nr * nc];
+    for i in 0..nr {
+        for j in 0..nc {
+            c[i * nc + j] = xs[j * nr + i];
+        }
+    }
+    pcall!(ffi::MatDenseRestoreArrayRead(x.0, &mut ptr))?;
+    if dbg { eprintln!("condense: dense solve {:.2} s", t.elapsed().as_secs_f64()); }
+    drop(b); // bcol outlives b
+    Ok(c)
+}
