@@ -21,6 +21,10 @@ pub fn build_mesh(scene: &Scene, half_z: bool) -> Result<Mesh, String> {
         contact: mesh::Rect { x0: scene.reynolds.x_min, x1: scene.reynolds.x_max, z0: scene.reynolds.z_min, z1: if half_z { 0.0 } else { scene.reynolds.z_max } },
         contact_size: scene.mesh.contact_size,
         growth: scene.mesh.growth,
+        core: (scene.mesh.core_size > 0.0).then(|| {
+            let w = scene.mesh.core_half_width;
+            (mesh::Rect { x0: -w, x1: w, z0: -w, z1: if half_z { 0.0 } else { w } }, scene.mesh.core_size)
+        }),
     };
     mesh::generate(&spec).map_err(|e| format!("mesh: {e}"))
 }

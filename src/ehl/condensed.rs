@@ -67,6 +67,8 @@ struct Element {
 /// The condensed EHL problem on one rank (all data replicated; rows distributed).
 pub struct CondensedSystem<'a> {
     pub comp: &'a Compliance,
+    /// Mesh, for developer diagnostics only.
+    pub debug_mesh: Option<&'a Mesh>,
     pub layout: CondensedLayout,
     pub rank: usize,
     pub params: EhlParams,
@@ -77,6 +79,9 @@ pub struct CondensedSystem<'a> {
     /// Rigid gap at each face node.
     gap: Vec<f64>,
     row_scale: Vec<f64>,
+    /// Pseudo-transient term (dt, rho H at the previous pseudo time at each owned P row's
+    /// node): area_j (rho_j H_j - old_j) / dt is added to Reynolds row j. None: steady.
+    pseudo: Option<(f64, Vec<f64>)>,
     pub residual_evals: usize,
     pub jacobian_evals: usize,
     pub step_limits: Vec<f64>,
@@ -115,6 +120,7 @@ impl<'a> CondensedSystem<'a> {
         let row_scale = vec![1.0; layout.total()];
         CondensedSystem {
             comp,
+            debug_mesh: None,
             layout,
             rank,
             params,
@@ -123,6 +129,7 @@ impl<'a> CondensedSystem<'a> {
             penalty_nodes,
             gap,
             row_scale,
+            pseudo: None,
             residual_evals: 0,
             jacobian_evals: 0,
             step_limits: Vec::new(),
@@ -167,7 +174,46 @@ impl<'a> CondensedSystem<'a> {
     }
 }
 
+impl CondensedSystem<'_> {
+    /// Developer aid (EHL_DEBUG): appends the iterate's centre lines to /tmp/ehl_debug_lines.csv.
+    fn debug_dump(&self, x: &[f64], h: &[f64]) {
+        use std::io::Write;
+        let Some(mesh) = self.debug_mesh else { return };
+        let mut f = std::fs::OpenOptions::new().create(true).append(true).open("/tmp/ehl_debug_lines.csv").unwrap();
+        let it = self.step_limits.len();
+        for (i, &n) in self.comp.rows.iter().enumerate() {
+            let c = mesh.nodes[n as usize];
+            if c[2].abs() < 1e-9 || c[0].abs() < 1e-9 {
+                let j = self.layout.p_index[n as usize];
+                let p = if j >= 0 { x[j as usize] } else { 0.0 };
+                let _ = writeln!(f, "{it},{},{},{},{}", c[0], c[2], p, h[i]);
+            }
+        }
+    }
+}
+
+impl CondensedSystem<'_> {
+    /// Switches the pseudo-transient term on with step `dt`, the old state being `x`
+    /// (pseudo-transient continuation: the steady solution does not depend on it).
+    fn pseudo_time(&mut self, dt: Option<f64>, x: &[f64]) {
+        self.pseudo = dt.map(|dt| {
+            let h = self.film(x);
+            let old = self
+                .penalty_nodes
+                .iter()
+                .map(|&(j, _)| (self.lubricant.rho)(x[j]).0 * h[self.layout.face_index[self.comp.cols[j] as usize] as usize])
+                .collect();
+            (dt, old)
+        });
+    }
+}
+
 impl EhlProblem for CondensedSystem<'_> {
+    fn set_pseudo_time(&mut self, dt: Option<f64>, x: &[f64]) -> bool {
+        self.pseudo_time(dt, x);
+        true
+    }
+
     fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant) {
         self.params.lambda_bar = lambda_bar;
         self.lubricant = lubricant;
@@ -185,7 +231,7 @@ impl EhlProblem for CondensedSystem<'_> {
             let out = reynolds_element(&e.verts, &p, &he, &e.vel, &fluid, &self.params.stabilisation);
             for i in 0..6 {
                 if e.p[i] >= 0 {
-                    diag[e.p[i] as usize] += out.dr_dp[i][i];
+                    diag[e.p[i] as usize] += out.dr_dp[i][i].abs();
                 }
             }
         }
@@ -229,11 +275,32 @@ impl Problem for CondensedSystem<'_> {
         for &(j, area) in &self.penalty_nodes {
             r[j - lo] += self.params.penalty * area * penalty_law(x[j]).0;
         }
+        if let Some((dt, old)) = &self.pseudo {
+            for (k, &(j, area)) in self.penalty_nodes.iter().enumerate() {
+                let hj = h[self.layout.face_index[self.comp.cols[j] as usize] as usize];
+                r[j - lo] += area * ((self.lubricant.rho)(x[j]).0 * hj - old[k]) / dt;
+            }
+        }
         for (i, v) in r.iter_mut().enumerate() {
             *v *= self.row_scale[lo + i];
         }
         if hi > self.layout.n_p {
             r[self.layout.h0() - lo] = load - self.params.load;
+        }
+        if std::env::var_os("EHL_DEBUG").is_some() {
+            if let Some(mesh) = self.debug_mesh {
+                let np = self.layout.n_p;
+                let mut order: Vec<usize> = (0..r.len()).filter(|&i| lo + i < np).collect();
+                order.sort_by(|&a, &b| r[b].abs().partial_cmp(&r[a].abs()).unwrap());
+                let norm: f64 = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+                let mut msg = format!("EHL_DEBUG rank {} |r| = {norm:.3e}; worst:", self.rank);
+                for &i in order.iter().take(4) {
+                    let n = self.comp.cols[lo + i];
+                    let c = mesh.nodes[n as usize];
+                    msg += &format!(" [{:.3e} at ({:.3},{:.3}) P={:.4} H={:.4}]", r[i], c[0], c[2], x[lo + i], h[self.layout.face_index[n as usize] as usize]);
+                }
+                eprintln!("{msg}");
+            }
         }
         let idx: Vec<i32> = (lo as i32..hi as i32).collect();
         f.set_values(&idx, &r, true)?;
@@ -242,10 +309,14 @@ impl Problem for CondensedSystem<'_> {
 
     fn limit_step(&mut self, x: &[f64], y: &[f64]) -> Result<f64> {
         const FILM_KEEP: f64 = 0.2;
+        let h = self.film(x);
         if std::env::var_os("EHL_NO_LIMIT").is_some() {
+            if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
+                self.step_limits.push(1.0);
+                self.debug_dump(x, &h);
+            }
             return Ok(1.0);
         }
-        let h = self.film(x);
         let dh0 = y[self.layout.h0()];
         let duy = self.comp.apply(&y[..self.layout.n_p]);
         let mut s: f64 = 1.0;
@@ -257,6 +328,11 @@ impl Problem for CondensedSystem<'_> {
             }
         }
         self.step_limits.push(s);
+        if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
+            let k = (0..h.len()).min_by(|&a, &b| h[a].partial_cmp(&h[b]).unwrap()).unwrap();
+            eprintln!("EHL_DEBUG limiter {s:.3e}; H0 = {:.4e} dH0 = {dh0:.3e}; min H = {:.3e} at node {}", x[self.layout.h0()], h[k], self.comp.rows[k]);
+            self.debug_dump(x, &h);
+        }
         Ok(s)
     }
 
@@ -298,6 +374,20 @@ impl Problem for CondensedSystem<'_> {
             let (_, dv) = penalty_law(x[jn]);
             let dv = dv.max(if CAVITATION_SMOOTHING > 0.0 { 0.0 } else { 1.0 });
             buf[(jn - lo) * n + jn] += self.params.penalty * area * dv;
+        }
+        if let Some((dt, _)) = &self.pseudo {
+            for &(jn, area) in &self.penalty_nodes {
+                let f = self.layout.face_index[self.comp.cols[jn] as usize] as usize;
+                let (rho, drho) = (self.lubricant.rho)(x[jn]);
+                let row = &mut buf[(jn - lo) * n..(jn - lo + 1) * n];
+                // d(rho H)/dP_k = rho' H delta_jk - rho C[f, k]; d/dH0 = rho.
+                row[jn] += area * drho * h[f] / dt;
+                let crow = &self.comp.c[f * np..(f + 1) * np];
+                for (a, c) in row[..np].iter_mut().zip(crow) {
+                    *a -= area * rho * c / dt;
+                }
+                row[np] += area * rho / dt;
+            }
         }
         for r in lo..hi.min(np) {
             let s = self.row_scale[r];

@@ -7,7 +7,11 @@
 //! the start; `EHL_DEBUG=1` prints residual norms per block, the step limiter's binding node
 //! and writes `debug_profile_z0.csv` after a failure; `EHL_START=zero` starts from P = 0,
 //! U = 0; `EHL_NO_ROW_SCALING=1` and `EHL_NO_LIMIT=1` switch off the row scaling and the
-//! film step limiter.
+//! film step limiter. `EHL_MONOLITHIC=1` solves the monolithic (U, P, H0) system instead of
+//! the condensed (P, H0) one; `EHL_PTC=1` (with `EHL_PTC_DT0`) tries pseudo-transient
+//! continuation before the load continuation; `EHL_SKIP_PLAIN=1` skips the plain Newton
+//! attempt. With `EHL_DEBUG=1` the condensed path prints its worst residual rows and appends
+//! the iterates' centre lines to /tmp/ehl_debug_lines.csv.
 use super::layout::Layout;
 use super::prealloc::preallocation;
 use super::condensed::CondensedSystem;
@@ -60,13 +64,25 @@ pub fn lambda_bar(scene: &Scene) -> f64 {
     12.0 * eta_r * ue * r * r / (h.a.powi(3) * h.ph)
 }
 
-/// Solves the displacement of the dry Hertz contact: the starting state of Newton.
+/// Solves the displacement under the Hertz pressure interpolated at the P2 nodes (the
+/// discrete pressure of the start, so the start satisfies the elastic rows exactly and
+/// equals the condensed path's start): the starting state of Newton.
 fn dry_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &Partition, dofs: &DofMap, k: &Matrix, nu: f64) -> petsc::Result<Vec<f64>> {
-    let b = assembly::assemble_pressure_load(comm, mesh, part, dofs, ctx.rank, assembly::traction_factor(nu), &|v| hertz_load::hertz_p2_load(v, 6))?;
+    let nodal = |v: &[[f64; 2]; 3]| -> [f64; 6] {
+        let pts = [v[0], v[1], v[2], mid(v[0], v[1]), mid(v[1], v[2]), mid(v[2], v[0])];
+        let p = pts.map(|q| hertz_load::hertz_pressure(q[0], q[1]));
+        let m = super::system::p2_tri_mass(super::system::tri_area(v));
+        std::array::from_fn(|i| (0..6).map(|j| m[i][j] * p[j]).sum())
+    };
+    let b = assembly::assemble_pressure_load(comm, mesh, part, dofs, ctx.rank, assembly::traction_factor(nu), &nodal)?;
     let ksp = Ksp::new(comm, k)?;
     let u = Vector::new(comm, dofs.local(ctx.rank))?;
     ksp.solve(&b, &u)?;
     u.gather_all()
+}
+
+fn mid(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
 }
 
 /// EHL parameters of the scene (dimensionless).
@@ -138,6 +154,7 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, h
     ));
     let mut system = CondensedSystem::new(mesh, &comp, ctx.size, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene));
     let cl = system.layout.clone();
+    system.debug_mesh = Some(mesh);
     // Start: Hertz pressure and its (condensed) deflection.
     let mut x0 = vec![0.0; cl.total()];
     for (j, &n) in comp.cols.iter().enumerate() {
@@ -249,12 +266,79 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     };
     // 1. Plain Newton from the Hertz start at the scene's operating point.
     let target = scene.operating.load;
-    let report = solve_at(target, system, x0)?;
+    let report = if std::env::var_os("EHL_SKIP_PLAIN").is_some() {
+        SolveReport { converged: false, reason: "SKIPPED".into(), reason_code: 0, iterations: 0, linear_iterations: 0, residual_norm: f64::NAN, domain_error: None }
+    } else {
+        solve_at(target, system, x0)?
+    };
     let mut steps = vec![format!("Newton from the Hertz start at L = {} N: {} ({} iterations)", target, report.reason, report.iterations)];
     ctx.log(&steps[0]);
     let mut newton_total = report.iterations;
     let mut last = report;
-    // 2. If it failed: continuation in load. A lighter load is a milder problem in Hertz
+    // 2. Experimental (developer switch EHL_PTC, condensed path only): pseudo-transient
+    //    continuation from the same start: implicit pseudo-time steps of the transient Reynolds equation, the
+    //    step growing as the steady residual falls (switched evolution relaxation), then
+    //    Newton on the steady problem.
+    if !last.converged {
+        let steady_norm = |system: &mut dyn EhlProblem, xs: &[f64]| -> Result<f64, String> {
+            let f = Vector::new(comm, local).map_err(pe)?;
+            f.set_all(0.0).map_err(pe)?;
+            match system.residual(xs, &f).map_err(pe)? {
+                crate::petsc::snes::Eval::Ok => {}
+                crate::petsc::snes::Eval::Domain(_) => return Ok(f64::INFINITY),
+            }
+            f.assemble().map_err(pe)?;
+            f.norm2().map_err(pe)
+        };
+        if std::env::var_os("EHL_PTC").is_some() && system.set_pseudo_time(None, x0) {
+            let mut sc = scene.clone();
+            sc.operating.load = target;
+            system.set_operating(lambda_bar(&sc), lubricant(&sc));
+            if scaling {
+                system.scale_rows(x0).map_err(pe)?;
+            }
+            let mut xk = x0.to_vec();
+            let mut fk = steady_norm(system, &xk)?;
+            let f_start = fk;
+            let mut dt: f64 = std::env::var("EHL_PTC_DT0").ok().and_then(|v| v.parse().ok()).unwrap_or(0.05);
+            let (mut n_steps, mut its) = (0usize, 0usize);
+            let mut ok = false;
+            while n_steps < 200 && dt > 1e-8 {
+                system.set_pseudo_time(Some(dt), &xk);
+                x.set_local_values(&xk[lo..hi]).map_err(pe)?;
+                let r = snes.solve(system, &x, j).map_err(pe)?;
+                its += r.iterations;
+                n_steps += 1;
+                if !r.converged {
+                    dt *= 0.25;
+                    continue;
+                }
+                let xn = x.gather_all().map_err(pe)?;
+                system.set_pseudo_time(None, &xn);
+                let fnew = steady_norm(system, &xn)?;
+                if std::env::var_os("EHL_DEBUG").is_some() {
+                    ctx.log(format!("pseudo-time step {n_steps}: dt = {dt:.3e}, {} its, steady residual {fnew:.3e}", r.iterations));
+                }
+                dt *= (fk / fnew).clamp(0.5, 4.0);
+                xk = xn;
+                fk = fnew;
+                if fk < 1e-3 * f_start || dt > 1e4 {
+                    ok = true;
+                    break;
+                }
+            }
+            system.set_pseudo_time(None, &xk);
+            newton_total += its;
+            steps.push(format!("pseudo-transient continuation: {n_steps} pseudo-time steps ({its} iterations), steady residual {:.2e} of the start's{}", fk / f_start, if ok { "" } else { " (gave up)" }));
+            ctx.log(steps.last().unwrap());
+            let r = solve_at(target, system, &xk)?;
+            newton_total += r.iterations;
+            steps.push(format!("Newton on the steady problem: {} ({} iterations)", r.reason, r.iterations));
+            ctx.log(steps.last().unwrap());
+            last = r;
+        }
+    }
+    // 3. If it failed: continuation in load. A lighter load is a milder problem in Hertz
     //    units (smaller M, alpha p_H); each converged state starts the next, heavier one.
     if !last.converged {
         let mut load = target / 8.0;

@@ -76,9 +76,20 @@ fn refined_bisector(spec: &MeshSpec, h: f64) -> refine::Bisector {
     let r = spec.contact;
     let (rlo, rhi) = ([r.x0, 0.0, r.z0], [r.x1, 0.0, r.z1]);
     let g = spec.growth;
+    let core = spec.core.map(|(c, size)| {
+        let mut hc = spec::COARSE_CELL;
+        while hc > size * (1.0 + 1e-12) {
+            hc *= 0.5;
+        }
+        ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], hc)
+    });
     b.refine_and_close(|v, t| {
         let d = refine::bbox_distance(v, t, &rlo, &rhi);
-        refine::longest_edge(v, t) > 3f64.sqrt() * (h + g * d) * (1.0 + 1e-10)
+        let mut target = h + g * d;
+        if let Some((lo, hi, hc)) = &core {
+            target = target.min(hc + g * refine::bbox_distance(v, t, lo, hi));
+        }
+        refine::longest_edge(v, t) > 3f64.sqrt() * target * (1.0 + 1e-10)
     });
     b
 }

@@ -44,6 +44,9 @@ pub struct MeshSpec {
     pub contact: Rect,
     pub contact_size: f64,
     pub growth: f64,
+    /// Optional finer core: a rectangle inside `contact` meshed with size `core.1`
+    /// (rounded down to 16/2^k), grading away from it at the same growth.
+    pub core: Option<(Rect, f64)>,
 }
 
 impl MeshSpec {
@@ -61,6 +64,7 @@ impl MeshSpec {
             },
             contact_size: 0.25,
             growth: 0.5,
+            core: None,
         }
     }
 
