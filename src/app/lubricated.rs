@@ -44,6 +44,12 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
         let prof_z0: Vec<Vec<f64>> = fields.profile([r.x0, 0.0], [r.x1, 0.0], 601).iter().map(|s| vec![s[0] * a, s[1] * a, s[2] * ph, s[3] * hs]).collect();
         write_profiles(ctx, "profile_x0.csv", &prof_x0)?;
         write_profiles(ctx, "profile_z0.csv", &prof_z0)?;
+        if scene.output.png {
+            write_plots(ctx, &fields, &mesh, a, ph, hs, &prof_x0, &prof_z0)?;
+        }
+        if scene.output.vtu {
+            write_face_vtu(ctx, &fields, &mesh, a, ph, hs)?;
+        }
         let hd = scene.hamrock_dowson();
         let summary = json!({
             "case": scene.name,
@@ -83,4 +89,79 @@ fn write_profiles(ctx: &Context, name: &str, rows: &[Vec<f64>]) -> Result<(), St
     }
     let path = ctx.out_dir.join(name);
     crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// Writes `path` through a temporary file and a rename, so a failure leaves no half file.
+fn atomic_with(path: &std::path::Path, write: impl FnOnce(&std::path::Path) -> Result<(), String>) -> Result<(), String> {
+    let tmp = path.with_extension("tmp");
+    write(&tmp)?;
+    std::fs::rename(&tmp, path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// PNG maps of p and h on the Reynolds rectangle and PNG plots of the two centre-line
+/// profiles (rank 0). Each P2 triangle is drawn as its 4 linear sub-triangles.
+fn write_plots(ctx: &Context, fields: &FieldsOnFace, mesh: &mesh::Mesh, a: f64, ph: f64, hs: f64, prof_x0: &[Vec<f64>], prof_z0: &[Vec<f64>]) -> Result<(), String> {
+    use crate::output::plot::{line_plot, map_plot, LineOpts, MapOpts, Series, Style};
+    const SUB: [[usize; 3]; 4] = [[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]];
+    let mut tris = Vec::new();
+    let (mut pv, mut hv) = (Vec::new(), Vec::new());
+    for tri in &mesh.contact_tris {
+        let xz = tri.map(|n| {
+            let c = mesh.nodes[n as usize];
+            [c[0], c[2]]
+        });
+        let p = tri.map(|n| fields.p_node(n) * ph * 1e-9);
+        let h = tri.map(|n| fields.h_node(n) * hs * 1e6);
+        for s in SUB {
+            tris.push(s.map(|k| xz[k]));
+            pv.push(s.map(|k| p[k]));
+            hv.push(s.map(|k| h[k]));
+        }
+    }
+    // The film grows to tens of um at the rectangle's corners: colours and the profile's
+    // film axis stop at 4 hc so the contact's film shape stays visible.
+    let h_top = 4.0 * fields.stats().hc * hs * 1e6;
+    let opts = |label: &str, range: Option<(f64, f64)>| MapOpts { circle: Some((0.0, 0.0, 1.0)), colorbar_label: label.to_string(), range, ..MapOpts::default() };
+    for (name, title, vals, label, range) in [
+        ("pressure_map.png", "pressure", &pv, "p (GPa)", None),
+        ("film_map.png", "film thickness (colours saturate at 4 hc)", &hv, "h (um)", Some((0.0, h_top))),
+    ] {
+        let path = ctx.out_dir.join(name);
+        atomic_with(&path, |t| map_plot(t, title, "x / a", "z / a", &tris, vals, &opts(label, range)))?;
+    }
+    for (name, title, rows, col, xl) in [
+        ("profile_z0.png", "centre line z = 0 (rolling direction)", prof_z0, 0usize, "x / a"),
+        ("profile_x0.png", "centre line x = 0 (transverse)", prof_x0, 1usize, "z / a"),
+    ] {
+        let x: Vec<f64> = rows.iter().map(|r| r[col] / a).collect();
+        let p = Series::new("p (GPa)", x.clone(), rows.iter().map(|r| r[2] * 1e-9).collect(), Style::Line);
+        let h = Series::new("h (um)", x, rows.iter().map(|r| r[3] * 1e6).collect(), Style::Line).on_secondary();
+        let lo = LineOpts { y2label: "h (um)".into(), y2_range: Some((0.0, h_top)), ..LineOpts::default() };
+        let path = ctx.out_dir.join(name);
+        atomic_with(&path, |t| line_plot(t, title, xl, "p (GPa)", &[p, h], &lo))?;
+    }
+    Ok(())
+}
+
+/// VTU of the contact face (P2 triangles, coordinates in m): p, h and the normal
+/// displacement u2, for ParaView.
+fn write_face_vtu(ctx: &Context, fields: &FieldsOnFace, mesh: &mesh::Mesh, a: f64, ph: f64, hs: f64) -> Result<(), String> {
+    let mut id = vec![u32::MAX; mesh.nodes.len()];
+    let mut points = Vec::new();
+    let (mut p, mut h, mut u2) = (Vec::new(), Vec::new(), Vec::new());
+    for &n in &mesh.contact_nodes {
+        id[n as usize] = points.len() as u32;
+        let c = mesh.nodes[n as usize];
+        points.push([c[0] * a, 0.0, c[2] * a]);
+        p.push(fields.p_node(n) * ph);
+        h.push(fields.h_node(n) * hs);
+        u2.push(fields.layout.uy(fields.x, n) * hs);
+    }
+    let conn: Vec<u32> = mesh.contact_tris.iter().flat_map(|t| t.map(|n| id[n as usize])).collect();
+    use crate::output::vtu::{write_vtu_single_type, Field};
+    let path = ctx.out_dir.join("contact_face.vtu");
+    atomic_with(&path, |t| {
+        write_vtu_single_type(t, &points, 22, &conn, &[Field { name: "p_pa", components: 1, values: &p }, Field { name: "h_m", components: 1, values: &h }, Field { name: "u2_m", components: 1, values: &u2 }], &[])
+            .map_err(|e| format!("cannot write {}: {e}", t.display()))
+    })
 }
