@@ -153,13 +153,7 @@ impl<'a> CondensedSystem<'a> {
     }
 
     fn fluid(&self) -> Fluid<'_> {
-        Fluid {
-            eta: &*self.lubricant.eta,
-            rho: &*self.lubricant.rho,
-            d2eta: &*self.lubricant.d2eta,
-            d2rho: &*self.lubricant.d2rho,
-            lambda_bar: self.params.lambda_bar,
-        }
+        self.lubricant.fluid(self.params.lambda_bar)
     }
 
     fn element_p(x: &[f64], e: &Element) -> [f64; 6] {

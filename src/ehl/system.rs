@@ -60,6 +60,13 @@ pub struct Lubricant {
     pub d2rho: Box<dyn Fn(f64) -> f64 + Send + Sync>,
 }
 
+impl Lubricant {
+    /// The laws as the Reynolds element takes them, with the speed parameter lambda_bar.
+    pub fn fluid(&self, lambda_bar: f64) -> Fluid<'_> {
+        Fluid { eta: &*self.eta, rho: &*self.rho, d2eta: &*self.d2eta, d2rho: &*self.d2rho, lambda_bar }
+    }
+}
+
 /// Everything the EHL residual needs besides the iterate.
 pub struct EhlParams {
     /// lambda_bar = 12 eta_R Ue R^2 / (a^3 p_H).
@@ -211,13 +218,7 @@ impl<'a> EhlSystem<'a> {
     }
 
     fn fluid(&self) -> Fluid<'_> {
-        Fluid {
-            eta: &*self.lubricant.eta,
-            rho: &*self.lubricant.rho,
-            d2eta: &*self.lubricant.d2eta,
-            d2rho: &*self.lubricant.d2rho,
-            lambda_bar: self.params.lambda_bar,
-        }
+        self.lubricant.fluid(self.params.lambda_bar)
     }
 
     /// Writes the iterate's displacement block into the displacement-only work vector.
