@@ -11,7 +11,7 @@ use super::system::EhlProblem;
 use crate::mesh::Mesh;
 use crate::petsc::snes::{Eval, Problem};
 use crate::petsc::{Matrix, Result, Vector};
-use crate::reynolds::element::{reynolds_element, Fluid};
+use crate::reynolds::element::{reynolds_element, ElementOut, Fluid};
 use crate::solid::condense::Compliance;
 
 /// Numbering of the condensed unknowns: P in `comp.cols` order, then H0; rank r owns
@@ -59,7 +59,10 @@ struct Element {
     p: [i32; 6],
     verts: [[f64; 2]; 3],
     vel: [[f64; 2]; 3],
-    area: f64,
+    /// Load weights (integral of each pressure basis function over the element).
+    w: [f64; 6],
+    /// Linear sub-triangle (P1-iso-P2 pressure): only the first 3 nodes are used.
+    linear: bool,
     /// Touches a row this rank owns.
     mine: bool,
 }
@@ -93,26 +96,42 @@ impl<'a> CondensedSystem<'a> {
         let (lo, hi) = (layout.ranges[rank], layout.ranges[rank + 1].min(layout.n_p));
         let mut node_area = vec![0.0; comp.rows.len()];
         let mut elements = Vec::new();
+        let linear = crate::reynolds::p1iso_pressure();
+        let owned = |d: i32| d >= 0 && (d as usize) >= lo && (d as usize) < hi;
         for tri in &mesh.contact_tris {
             let xz = |n: u32| {
                 let c = mesh.nodes[n as usize];
                 [c[0], c[2]]
             };
-            let verts = [xz(tri[0]), xz(tri[1]), xz(tri[2])];
             let face = tri.map(|n| layout.face_index[n as usize] as usize);
             let p = tri.map(|n| layout.p_index[n as usize]);
+            if linear {
+                for sub in crate::reynolds::P2_SUB_TRIANGLES {
+                    let verts = sub.map(|k| xz(tri[k]));
+                    let area = tri_area(&verts);
+                    let f6: [usize; 6] = std::array::from_fn(|i| face[sub[i.min(2)]]);
+                    let p6: [i32; 6] = std::array::from_fn(|i| if i < 3 { p[sub[i]] } else { -1 });
+                    let w: [f64; 6] = std::array::from_fn(|i| if i < 3 { area / 3.0 } else { 0.0 });
+                    for i in 0..3 {
+                        node_area[f6[i]] += area / 3.0;
+                    }
+                    elements.push(Element { face: f6, p: p6, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w, linear: true, mine: p6.iter().any(|&d| owned(d)) });
+                }
+                continue;
+            }
+            let verts = [xz(tri[0]), xz(tri[1]), xz(tri[2])];
             let area = tri_area(&verts);
             for &f in &face {
                 node_area[f] += area / 6.0;
             }
-            let mine = p.iter().any(|&d| d >= 0 && (d as usize) >= lo && (d as usize) < hi);
             elements.push(Element {
                 face,
                 p,
                 verts,
                 vel: verts.map(|v| (params.velocity)(v[0], v[1])),
-                area,
-                mine,
+                w: p2_tri_weights(area),
+                linear: false,
+                mine: p.iter().any(|&d| owned(d)),
             });
         }
         let penalty_nodes = (lo..hi).map(|j| (j, node_area[layout.face_index[comp.cols[j] as usize] as usize])).collect();
@@ -154,6 +173,21 @@ impl<'a> CondensedSystem<'a> {
 
     fn fluid(&self) -> Fluid<'_> {
         self.lubricant.fluid(self.params.lambda_bar)
+    }
+
+    /// Residual and Jacobian of one element (P2, or a linear sub-triangle padded to 6 nodes).
+    fn eval(&self, e: &Element, p: &[f64; 6], h: &[f64; 6], fluid: &Fluid) -> ElementOut {
+        if !e.linear {
+            return reynolds_element(&e.verts, p, h, &e.vel, fluid, &self.params.stabilisation);
+        }
+        let (r, dp, dh) = crate::reynolds::p1::reynolds_p1_element(&e.verts, &[p[0], p[1], p[2]], &[h[0], h[1], h[2]], &e.vel, fluid);
+        let mut out = ElementOut { r: [0.0; 6], dr_dp: [[0.0; 6]; 6], dr_dh: [[0.0; 6]; 6] };
+        for i in 0..3 {
+            out.r[i] = r[i];
+            out.dr_dp[i][..3].copy_from_slice(&dp[i]);
+            out.dr_dh[i][..3].copy_from_slice(&dh[i]);
+        }
+        out
     }
 
     fn element_p(x: &[f64], e: &Element) -> [f64; 6] {
@@ -222,7 +256,7 @@ impl EhlProblem for CondensedSystem<'_> {
         for e in self.elements.iter().filter(|e| e.mine) {
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
-            let out = reynolds_element(&e.verts, &p, &he, &e.vel, &fluid, &self.params.stabilisation);
+            let out = self.eval(e, &p, &he, &fluid);
             for i in 0..6 {
                 if e.p[i] >= 0 {
                     diag[e.p[i] as usize] += out.dr_dp[i][i].abs();
@@ -252,13 +286,13 @@ impl Problem for CondensedSystem<'_> {
         let mut load = 0.0;
         for e in &self.elements {
             let p = Self::element_p(x, e);
-            let w = p2_tri_weights(e.area);
+            let w = e.w;
             load += (0..6).map(|k| w[k] * p[k]).sum::<f64>();
             if !e.mine {
                 continue;
             }
             let he = e.face.map(|f| h[f]);
-            let out = reynolds_element(&e.verts, &p, &he, &e.vel, &fluid, &self.params.stabilisation);
+            let out = self.eval(e, &p, &he, &fluid);
             for i in 0..6 {
                 let d = e.p[i];
                 if d >= 0 && (d as usize) >= lo && (d as usize) < hi {
@@ -341,7 +375,7 @@ impl Problem for CondensedSystem<'_> {
         for e in self.elements.iter().filter(|e| e.mine) {
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
-            let out = reynolds_element(&e.verts, &p, &he, &e.vel, &fluid, &self.params.stabilisation);
+            let out = self.eval(e, &p, &he, &fluid);
             for i in 0..6 {
                 let d = e.p[i];
                 if d < 0 || (d as usize) < lo || (d as usize) >= hi {
@@ -393,7 +427,7 @@ impl Problem for CondensedSystem<'_> {
             // Load row: integral of P.
             let row = &mut buf[(np - lo) * n..];
             for e in &self.elements {
-                let w = p2_tri_weights(e.area);
+                let w = e.w;
                 for k in 0..6 {
                     if e.p[k] >= 0 {
                         row[e.p[k] as usize] += w[k];

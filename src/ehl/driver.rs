@@ -10,7 +10,9 @@
 //! film step limiter. `EHL_MONOLITHIC=1` solves the monolithic (U, P, H0) system instead of
 //! the condensed (P, H0) one; `EHL_PTC=1` (with `EHL_PTC_DT0`) tries pseudo-transient
 //! continuation before the load continuation; `EHL_SKIP_PLAIN=1` skips the plain Newton
-//! attempt. With `EHL_DEBUG=1` the condensed path prints its worst residual rows and appends
+//! attempt. `EHL_P1ISO=1` (condensed path) uses linear pressure on the P2 sub-triangles;
+//! `EHL_SUPG_COUETTE=1` keeps only the Couette part in the SUPG strong residual.
+//! With `EHL_DEBUG=1` the condensed path prints its worst residual rows and appends
 //! the iterates' centre lines to /tmp/ehl_debug_lines.csv.
 use super::layout::Layout;
 use super::prealloc::preallocation;

@@ -253,7 +253,9 @@ pub fn reynolds_element_with_source(
             let conv = (drho_h * gp[0] + rho_d * gh[0]) * v[0]
                 + (drho_h * gp[1] + rho_d * gh[1]) * v[1]
                 + rho_h * div_v;
-            let r_strong = conv - div_flux - f;
+            // Developer experiment (EHL_SUPG_COUETTE=1): streamline diffusion of the Couette
+            // flux only, dropping the Poiseuille part of the strong residual.
+            let r_strong = if couette_only() { conv - f } else { conv - div_flux - f };
 
             // tau = delta h_e / (2|v|) xi(Pe), Pe = |v| h_e / (2 eps), h_e = streamline length
             let h_e = streamline_length(&tri, v);
@@ -278,4 +280,9 @@ pub fn reynolds_element_with_source(
         out.dr_dh[i].copy_from_slice(&res[i].d[6..]);
     }
     out
+}
+
+fn couette_only() -> bool {
+    static FLAG: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *FLAG.get_or_init(|| std::env::var_os("EHL_SUPG_COUETTE").is_some())
 }

@@ -77,6 +77,7 @@
 
 pub mod dual;
 pub mod element;
+pub mod p1;
 pub mod p2;
 pub mod quadrature;
 
@@ -89,3 +90,13 @@ pub use element::{
     Stabilisation,
 };
 pub use p2::P2Triangle;
+
+/// The 4 sub-triangles of a P2 triangle (local nodes v0, v1, v2, m01, m12, m20), same
+/// orientation as the parent.
+pub const P2_SUB_TRIANGLES: [[usize; 3]; 4] = [[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]];
+
+/// Developer switch (experimental, condensed path only): pressure linear on the 4
+/// sub-triangles of every P2 face triangle (`EHL_P1ISO=1`).
+pub fn p1iso_pressure() -> bool {
+    std::env::var_os("EHL_P1ISO").is_some()
+}

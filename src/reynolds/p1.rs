@@ -1,0 +1,112 @@
+//! Linear (P1) Galerkin element of the dimensionless Reynolds equation on one straight
+//! triangle, with its exact Jacobian (forward-mode duals over the 3 nodal P and 3 nodal H):
+//! ```text
+//!   R_i = int_T [ eps grad P . grad L_i - rho_bar H (v . grad L_i) ],
+//!   eps = rho_bar H^3 / (eta_bar lambda_bar).
+//! ```
+//! Used on the 4 sub-triangles of each P2 face triangle ("P1-iso-P2" pressure): the same
+//! nodes as P2, but every basis function integrates to area/3 > 0, so every nodal pressure
+//! carries load (a P2 vertex function integrates to zero).
+use super::dual::Dual;
+use super::element::Fluid;
+use super::quadrature::DUNAVANT6;
+
+type D6 = Dual<6>;
+
+/// Residual, dR/dP and dR/dH of one P1 triangle. `vel`: entrainment at the 3 vertices.
+pub fn reynolds_p1_element(verts: &[[f64; 2]; 3], p: &[f64; 3], h: &[f64; 3], vel: &[[f64; 2]; 3], fluid: &Fluid) -> ([f64; 3], [[f64; 3]; 3], [[f64; 3]; 3]) {
+    let (x, z) = (verts.map(|v| v[0]), verts.map(|v| v[1]));
+    let det = (x[1] - x[0]) * (z[2] - z[0]) - (x[2] - x[0]) * (z[1] - z[0]);
+    let area = 0.5 * det.abs();
+    // grad L_k = (z_{k+1} - z_{k+2}, x_{k+2} - x_{k+1}) / det
+    let g: [[f64; 2]; 3] = std::array::from_fn(|k| {
+        let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+        [(z[a] - z[b]) / det, (x[b] - x[a]) / det]
+    });
+    let pd: [D6; 3] = std::array::from_fn(|j| D6::variable(p[j], j));
+    let hd: [D6; 3] = std::array::from_fn(|j| D6::variable(h[j], 3 + j));
+    let mut gp = [D6::constant(0.0); 2];
+    for j in 0..3 {
+        for c in 0..2 {
+            gp[c] += pd[j] * g[j][c];
+        }
+    }
+    let mut res = [D6::constant(0.0); 3];
+    for q in DUNAVANT6.iter() {
+        let l = q.l;
+        let wq = q.w * area;
+        let mut pq = D6::constant(0.0);
+        let mut hq = D6::constant(0.0);
+        for j in 0..3 {
+            pq += pd[j] * l[j];
+            hq += hd[j] * l[j];
+        }
+        let v = [0, 1].map(|c| l[0] * vel[0][c] + l[1] * vel[1][c] + l[2] * vel[2][c]);
+        let (eta, deta) = (fluid.eta)(pq.v);
+        let (rho, drho) = (fluid.rho)(pq.v);
+        let eta_d = pq.chain(eta, deta);
+        let rho_d = pq.chain(rho, drho);
+        let eps = rho_d * hq * hq * hq / (eta_d * fluid.lambda_bar);
+        let rho_h = rho_d * hq;
+        for i in 0..3 {
+            let flux = gp[0] * g[i][0] + gp[1] * g[i][1];
+            let vg = v[0] * g[i][0] + v[1] * g[i][1];
+            res[i] += (eps * flux - rho_h * vg) * wq;
+        }
+    }
+    let r = res.map(|d| d.v);
+    let dp = res.map(|d| [d.d[0], d.d[1], d.d[2]]);
+    let dh = res.map(|d| [d.d[3], d.d[4], d.d[5]]);
+    (r, dp, dh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn laws() -> (impl Fn(f64) -> (f64, f64), impl Fn(f64) -> (f64, f64)) {
+        (|p: f64| ((2.0 * p).exp(), 2.0 * (2.0 * p).exp()), |p: f64| ((1.0 + 2.0 * p) / (1.0 + p), 1.0 / ((1.0 + p) * (1.0 + p))))
+    }
+
+    #[test]
+    fn jacobian_matches_central_differences() {
+        let (eta, rho) = laws();
+        let zero = |_: f64| 0.0;
+        let fluid = Fluid { eta: &eta, rho: &rho, d2eta: &zero, d2rho: &zero, lambda_bar: 0.3 };
+        let verts = [[0.1, -0.2], [0.6, 0.05], [0.2, 0.4]];
+        let vel = [[1.0, 0.1], [0.9, -0.2], [1.1, 0.0]];
+        let (p, h) = ([0.3, 0.7, 0.5], [0.4, 0.25, 0.6]);
+        let (_, dp, dh) = reynolds_p1_element(&verts, &p, &h, &vel, &fluid);
+        let d = 1e-6;
+        for j in 0..3 {
+            let (mut pp, mut pm) = (p, p);
+            pp[j] += d;
+            pm[j] -= d;
+            let (rp, _, _) = reynolds_p1_element(&verts, &pp, &h, &vel, &fluid);
+            let (rm, _, _) = reynolds_p1_element(&verts, &pm, &h, &vel, &fluid);
+            let (mut hp, mut hm) = (h, h);
+            hp[j] += d;
+            hm[j] -= d;
+            let (sp, _, _) = reynolds_p1_element(&verts, &p, &hp, &vel, &fluid);
+            let (sm, _, _) = reynolds_p1_element(&verts, &p, &hm, &vel, &fluid);
+            for i in 0..3 {
+                assert!((dp[i][j] - (rp[i] - rm[i]) / (2.0 * d)).abs() < 1e-7 * (1.0 + dp[i][j].abs()));
+                assert!((dh[i][j] - (sp[i] - sm[i]) / (2.0 * d)).abs() < 1e-7 * (1.0 + dh[i][j].abs()));
+            }
+        }
+    }
+
+    /// Constant P and H with a uniform velocity: the flux rho H v is divergence-free, so the
+    /// residuals of an element sum to zero (sum of grad L_i = 0), whatever the laws.
+    #[test]
+    fn uniform_state_residuals_sum_to_zero() {
+        let (eta, rho) = laws();
+        let zero = |_: f64| 0.0;
+        let fluid = Fluid { eta: &eta, rho: &rho, d2eta: &zero, d2rho: &zero, lambda_bar: 0.3 };
+        let (r, _, _) = reynolds_p1_element(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], &[0.5; 3], &[0.2; 3], &[[1.0, 0.0]; 3], &fluid);
+        assert!((r[0] + r[1] + r[2]).abs() < 1e-14);
+        // Exact Couette part: -rho H v . grad L_i * area; grad L_0 = (-1, -1), area 1/2.
+        let expect0 = -(rho(0.5).0 * 0.2) * (-1.0) * 0.5;
+        assert!((r[0] - expect0).abs() < 1e-14, "{} vs {expect0}", r[0]);
+    }
+}
