@@ -11,7 +11,8 @@
 //! the condensed (P, H0) one; `EHL_PTC=1` (with `EHL_PTC_DT0`) tries pseudo-transient
 //! continuation before the load continuation; `EHL_SKIP_PLAIN=1` skips the plain Newton
 //! attempt. `EHL_P1ISO=1` (condensed path) uses linear pressure on the P2 sub-triangles;
-//! `EHL_SUPG_COUETTE=1` keeps only the Couette part in the SUPG strong residual.
+//! `EHL_SUPG_COUETTE=1` keeps only the Couette part in the SUPG strong residual;
+//! `EHL_SUPG_DELTA` scales the SUPG parameter tau (default 1).
 //! With `EHL_DEBUG=1` the condensed path prints its worst residual rows and appends
 //! the iterates' centre lines to /tmp/ehl_debug_lines.csv.
 use super::layout::Layout;
@@ -99,7 +100,7 @@ fn ehl_params(scene: &Scene, nu: f64, half: bool) -> EhlParams {
         penalty: if scene.effects.cavitation == crate::case::CavitationModel::Penalty { scene.reynolds.penalty } else { 0.0 },
         stabilisation: crate::reynolds::element::Stabilisation {
             supg: scene.reynolds.stabilisation == crate::case::Stabilisation::Supg,
-            delta: 1.0,
+            delta: std::env::var("EHL_SUPG_DELTA").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0),
             id: scene.reynolds.artificial_diffusion,
         },
         velocity: Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue]),
