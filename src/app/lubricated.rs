@@ -45,10 +45,10 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
         write_profiles(ctx, "profile_x0.csv", &prof_x0)?;
         write_profiles(ctx, "profile_z0.csv", &prof_z0)?;
         if scene.output.png {
-            write_plots(ctx, &fields, &mesh, a, ph, hs, &prof_x0, &prof_z0)?;
+            write_plots(ctx, &fields, a, ph, hs, &prof_x0, &prof_z0)?;
         }
         if scene.output.vtu {
-            write_face_vtu(ctx, &fields, &mesh, a, ph, hs)?;
+            write_face_vtu(ctx, &fields, a, ph, hs)?;
         }
         let hd = scene.hamrock_dowson();
         let summary = json!({
@@ -91,18 +91,11 @@ fn write_profiles(ctx: &Context, name: &str, rows: &[Vec<f64>]) -> Result<(), St
     crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
-/// Writes `path` through a temporary file and a rename, so a failure leaves no half file.
-fn atomic_with(path: &std::path::Path, write: impl FnOnce(&std::path::Path) -> Result<(), String>) -> Result<(), String> {
-    let tmp = path.with_extension("tmp");
-    write(&tmp)?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("cannot write {}: {e}", path.display()))
-}
-
 /// PNG maps of p and h on the Reynolds rectangle and PNG plots of the two centre-line
 /// profiles (rank 0). Each P2 triangle is drawn as its 4 linear sub-triangles.
-fn write_plots(ctx: &Context, fields: &FieldsOnFace, mesh: &mesh::Mesh, a: f64, ph: f64, hs: f64, prof_x0: &[Vec<f64>], prof_z0: &[Vec<f64>]) -> Result<(), String> {
+fn write_plots(ctx: &Context, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, prof_x0: &[Vec<f64>], prof_z0: &[Vec<f64>]) -> Result<(), String> {
+    let mesh = fields.mesh;
     use crate::output::plot::{line_plot, map_plot, LineOpts, MapOpts, Series, Style};
-    const SUB: [[usize; 3]; 4] = [[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]];
     let mut tris = Vec::new();
     let (mut pv, mut hv) = (Vec::new(), Vec::new());
     for tri in &mesh.contact_tris {
@@ -112,7 +105,7 @@ fn write_plots(ctx: &Context, fields: &FieldsOnFace, mesh: &mesh::Mesh, a: f64, 
         });
         let p = tri.map(|n| fields.p_node(n) * ph * 1e-9);
         let h = tri.map(|n| fields.h_node(n) * hs * 1e6);
-        for s in SUB {
+        for s in crate::reynolds::P2_SUB_TRIANGLES {
             tris.push(s.map(|k| xz[k]));
             pv.push(s.map(|k| p[k]));
             hv.push(s.map(|k| h[k]));
@@ -127,7 +120,7 @@ fn write_plots(ctx: &Context, fields: &FieldsOnFace, mesh: &mesh::Mesh, a: f64, 
         ("film_map.png", "film thickness (colours saturate at 4 hc)", &hv, "h (um)", Some((0.0, h_top))),
     ] {
         let path = ctx.out_dir.join(name);
-        atomic_with(&path, |t| map_plot(t, title, "x / a", "z / a", &tris, vals, &opts(label, range)))?;
+        crate::output::write_atomic_with(&path, |t| map_plot(t, title, "x / a", "z / a", &tris, vals, &opts(label, range)))?;
     }
     for (name, title, rows, col, xl) in [
         ("profile_z0.png", "centre line z = 0 (rolling direction)", prof_z0, 0usize, "x / a"),
@@ -138,14 +131,15 @@ fn write_plots(ctx: &Context, fields: &FieldsOnFace, mesh: &mesh::Mesh, a: f64, 
         let h = Series::new("h (um)", x, rows.iter().map(|r| r[3] * 1e6).collect(), Style::Line).on_secondary();
         let lo = LineOpts { y2label: "h (um)".into(), y2_range: Some((0.0, h_top)), ..LineOpts::default() };
         let path = ctx.out_dir.join(name);
-        atomic_with(&path, |t| line_plot(t, title, xl, "p (GPa)", &[p, h], &lo))?;
+        crate::output::write_atomic_with(&path, |t| line_plot(t, title, xl, "p (GPa)", &[p, h], &lo))?;
     }
     Ok(())
 }
 
 /// VTU of the contact face (P2 triangles, coordinates in m): p, h and the normal
 /// displacement u2, for ParaView.
-fn write_face_vtu(ctx: &Context, fields: &FieldsOnFace, mesh: &mesh::Mesh, a: f64, ph: f64, hs: f64) -> Result<(), String> {
+fn write_face_vtu(ctx: &Context, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64) -> Result<(), String> {
+    let mesh = fields.mesh;
     let mut id = vec![u32::MAX; mesh.nodes.len()];
     let mut points = Vec::new();
     let (mut p, mut h, mut u2) = (Vec::new(), Vec::new(), Vec::new());
@@ -160,7 +154,7 @@ fn write_face_vtu(ctx: &Context, fields: &FieldsOnFace, mesh: &mesh::Mesh, a: f6
     let conn: Vec<u32> = mesh.contact_tris.iter().flat_map(|t| t.map(|n| id[n as usize])).collect();
     use crate::output::vtu::{write_vtu_single_type, Field};
     let path = ctx.out_dir.join("contact_face.vtu");
-    atomic_with(&path, |t| {
+    crate::output::write_atomic_with(&path, |t| {
         write_vtu_single_type(t, &points, 22, &conn, &[Field { name: "p_pa", components: 1, values: &p }, Field { name: "h_m", components: 1, values: &h }, Field { name: "u2_m", components: 1, values: &u2 }], &[])
             .map_err(|e| format!("cannot write {}: {e}", t.display()))
     })

@@ -77,8 +77,8 @@ pub struct CondensedSystem<'a> {
     pub params: EhlParams,
     pub lubricant: Lubricant,
     elements: Vec<Element>,
-    /// (pressure unknown, nodal area) of owned pressure rows.
-    penalty_nodes: Vec<(usize, f64)>,
+    /// (pressure unknown, face index, nodal area) of the owned pressure rows.
+    penalty_nodes: Vec<(usize, usize, f64)>,
     /// Rigid gap at each face node.
     gap: Vec<f64>,
     row_scale: Vec<f64>,
@@ -134,7 +134,12 @@ impl<'a> CondensedSystem<'a> {
                 mine: p.iter().any(|&d| owned(d)),
             });
         }
-        let penalty_nodes = (lo..hi).map(|j| (j, node_area[layout.face_index[comp.cols[j] as usize] as usize])).collect();
+        let penalty_nodes = (lo..hi)
+            .map(|j| {
+                let f = layout.face_index[comp.cols[j] as usize] as usize;
+                (j, f, node_area[f])
+            })
+            .collect();
         let gap = comp.rows.iter().map(|&n| super::layout::Layout::gap(mesh.nodes[n as usize])).collect();
         let row_scale = vec![1.0; layout.total()];
         CondensedSystem {
@@ -157,6 +162,12 @@ impl<'a> CondensedSystem<'a> {
 
     fn owned(&self) -> (usize, usize) {
         (self.layout.ranges[self.rank], self.layout.ranges[self.rank + 1])
+    }
+
+    /// Local row of pressure unknown `d` if this rank owns it (None for -1 or another rank's).
+    fn own_row(&self, d: i32) -> Option<usize> {
+        let (lo, hi) = self.owned();
+        (d >= 0 && (d as usize) >= lo && (d as usize) < hi).then(|| d as usize - lo)
     }
 
     /// Film H at every face node for the iterate x = (P, H0).
@@ -200,9 +211,7 @@ impl<'a> CondensedSystem<'a> {
         let n = self.layout.total();
         (vec![nl as i32; nl], vec![(n - nl) as i32; nl])
     }
-}
 
-impl CondensedSystem<'_> {
     /// Developer aid (EHL_DEBUG): appends the iterate's centre lines to /tmp/ehl_debug_lines.csv.
     fn debug_dump(&self, x: &[f64], h: &[f64]) {
         use std::io::Write;
@@ -220,25 +229,15 @@ impl CondensedSystem<'_> {
     }
 }
 
-impl CondensedSystem<'_> {
+impl EhlProblem for CondensedSystem<'_> {
     /// Switches the pseudo-transient term on with step `dt`, the old state being `x`
     /// (pseudo-transient continuation: the steady solution does not depend on it).
-    fn pseudo_time(&mut self, dt: Option<f64>, x: &[f64]) {
+    fn set_pseudo_time(&mut self, dt: Option<f64>, x: &[f64]) -> bool {
         self.pseudo = dt.map(|dt| {
             let h = self.film(x);
-            let old = self
-                .penalty_nodes
-                .iter()
-                .map(|&(j, _)| (self.lubricant.rho)(x[j]).0 * h[self.layout.face_index[self.comp.cols[j] as usize] as usize])
-                .collect();
+            let old = self.penalty_nodes.iter().map(|&(j, f, _)| (self.lubricant.rho)(x[j]).0 * h[f]).collect();
             (dt, old)
         });
-    }
-}
-
-impl EhlProblem for CondensedSystem<'_> {
-    fn set_pseudo_time(&mut self, dt: Option<f64>, x: &[f64]) -> bool {
-        self.pseudo_time(dt, x);
         true
     }
 
@@ -283,36 +282,37 @@ impl Problem for CondensedSystem<'_> {
         let (lo, hi) = self.owned();
         let mut r = vec![0.0; hi - lo];
         let fluid = self.fluid();
-        let mut load = 0.0;
-        for e in &self.elements {
+        for e in self.elements.iter().filter(|e| e.mine) {
             let p = Self::element_p(x, e);
-            let w = e.w;
-            load += (0..6).map(|k| w[k] * p[k]).sum::<f64>();
-            if !e.mine {
-                continue;
-            }
             let he = e.face.map(|f| h[f]);
             let out = self.eval(e, &p, &he, &fluid);
             for i in 0..6 {
-                let d = e.p[i];
-                if d >= 0 && (d as usize) >= lo && (d as usize) < hi {
-                    r[d as usize - lo] += out.r[i];
+                if let Some(l) = self.own_row(e.p[i]) {
+                    r[l] += out.r[i];
                 }
             }
         }
-        for &(j, area) in &self.penalty_nodes {
+        for &(j, _, area) in &self.penalty_nodes {
             r[j - lo] += self.params.penalty * area * penalty_law(x[j]).0;
         }
         if let Some((dt, old)) = &self.pseudo {
-            for (k, &(j, area)) in self.penalty_nodes.iter().enumerate() {
-                let hj = h[self.layout.face_index[self.comp.cols[j] as usize] as usize];
-                r[j - lo] += area * ((self.lubricant.rho)(x[j]).0 * hj - old[k]) / dt;
+            for (k, &(j, f, area)) in self.penalty_nodes.iter().enumerate() {
+                r[j - lo] += area * ((self.lubricant.rho)(x[j]).0 * h[f] - old[k]) / dt;
             }
         }
         for (i, v) in r.iter_mut().enumerate() {
             *v *= self.row_scale[lo + i];
         }
         if hi > self.layout.n_p {
+            // Load balance, on the rank that owns H0.
+            let load: f64 = self
+                .elements
+                .iter()
+                .map(|e| {
+                    let p = Self::element_p(x, e);
+                    (0..6).map(|k| e.w[k] * p[k]).sum::<f64>()
+                })
+                .sum();
             r[self.layout.h0() - lo] = load - self.params.load;
         }
         if std::env::var_os("EHL_DEBUG").is_some() {
@@ -377,11 +377,8 @@ impl Problem for CondensedSystem<'_> {
             let he = e.face.map(|f| h[f]);
             let out = self.eval(e, &p, &he, &fluid);
             for i in 0..6 {
-                let d = e.p[i];
-                if d < 0 || (d as usize) < lo || (d as usize) >= hi {
-                    continue;
-                }
-                let row = &mut buf[(d as usize - lo) * n..(d as usize - lo + 1) * n];
+                let Some(l) = self.own_row(e.p[i]) else { continue };
+                let row = &mut buf[l * n..(l + 1) * n];
                 for k in 0..6 {
                     if e.p[k] >= 0 {
                         row[e.p[k] as usize] += out.dr_dp[i][k];
@@ -398,14 +395,13 @@ impl Problem for CondensedSystem<'_> {
                 }
             }
         }
-        for &(jn, area) in &self.penalty_nodes {
+        for &(jn, _, area) in &self.penalty_nodes {
             let (_, dv) = penalty_law(x[jn]);
             let dv = dv.max(if CAVITATION_SMOOTHING > 0.0 { 0.0 } else { 1.0 });
             buf[(jn - lo) * n + jn] += self.params.penalty * area * dv;
         }
         if let Some((dt, _)) = &self.pseudo {
-            for &(jn, area) in &self.penalty_nodes {
-                let f = self.layout.face_index[self.comp.cols[jn] as usize] as usize;
+            for &(jn, f, area) in &self.penalty_nodes {
                 let (rho, drho) = (self.lubricant.rho)(x[jn]);
                 let row = &mut buf[(jn - lo) * n..(jn - lo + 1) * n];
                 // d(rho H)/dP_k = rho' H delta_jk - rho C[f, k]; d/dH0 = rho.

@@ -72,8 +72,7 @@ pub fn lambda_bar(scene: &Scene) -> f64 {
 /// equals the condensed path's start): the starting state of Newton.
 fn dry_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &Partition, dofs: &DofMap, k: &Matrix, nu: f64) -> petsc::Result<Vec<f64>> {
     let nodal = |v: &[[f64; 2]; 3]| -> [f64; 6] {
-        let pts = [v[0], v[1], v[2], mid(v[0], v[1]), mid(v[1], v[2]), mid(v[2], v[0])];
-        let p = pts.map(|q| hertz_load::hertz_pressure(q[0], q[1]));
+        let p = crate::fem::p2tri::p2_tri_node_coords(v).map(|q| hertz_load::hertz_pressure(q[0], q[1]));
         let m = super::system::p2_tri_mass(super::system::tri_area(v));
         std::array::from_fn(|i| (0..6).map(|j| m[i][j] * p[j]).sum())
     };
@@ -82,10 +81,6 @@ fn dry_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &Part
     let u = Vector::new(comm, dofs.local(ctx.rank))?;
     ksp.solve(&b, &u)?;
     u.gather_all()
-}
-
-fn mid(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
 }
 
 /// EHL parameters of the scene (dimensionless).

@@ -80,7 +80,8 @@ fn face_mass(mesh: &Mesh, rows: &[u32], cols: &[u32]) -> Vec<f64> {
     if crate::reynolds::p1iso_pressure() {
         // Pressure linear on the 4 sub-triangles (P1-iso-P2), displacement test functions P2:
         // B[i][j] = int N_i^{P2} phi_j, by a degree-6 rule on each sub-triangle.
-        const BARY: [[f64; 3]; 6] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]];
+        use crate::fem::p2tri::{tri_bary, P2_TRI_REF_NODES};
+        let bary = P2_TRI_REF_NODES.map(tri_bary);
         for tri in &mesh.contact_tris {
             let xz = |n: u32| {
                 let c = mesh.nodes[n as usize];
@@ -89,7 +90,7 @@ fn face_mass(mesh: &Mesh, rows: &[u32], cols: &[u32]) -> Vec<f64> {
             let area = crate::ehl::system::tri_area(&[xz(tri[0]), xz(tri[1]), xz(tri[2])]) / 4.0;
             for sub in crate::reynolds::P2_SUB_TRIANGLES {
                 for q in crate::reynolds::quadrature::DUNAVANT6.iter() {
-                    let lp: [f64; 3] = std::array::from_fn(|c| (0..3).map(|k| q.l[k] * BARY[sub[k]][c]).sum());
+                    let lp: [f64; 3] = std::array::from_fn(|c| (0..3).map(|k| q.l[k] * bary[sub[k]][c]).sum());
                     let n2 = crate::fem::p2tri::p2_tri_basis_bary(lp);
                     for a in 0..6 {
                         let i = row_of[tri[a] as usize];
