@@ -1,5 +1,5 @@
-//! A lubricated run that converges end to end (light load, coarse mesh, the experimental
-//! artificial diffusion that lets Newton converge today) under 2 MPI ranks: the load balance
+//! A lubricated run that converges end to end (light load, coarse mesh, with the optional
+//! isotropic artificial diffusion on, so that path runs too) under 2 MPI ranks: the load balance
 //! closes, and every output the user looks at is written: summary.json, the two profile
 //! CSVs, the PNG maps and profiles, the contact-face VTU.
 //! This checks the pipeline, not the film values (see README "Lubricated solver: state").

@@ -537,8 +537,14 @@ pub const EFFECTS_FIELDS: &[Field] = &[
 choice_enum! {
     /// `reynolds.stabilisation`: stabilisation of the Reynolds equation.
     pub enum Stabilisation {
-        /// Streamline-upwind Petrov-Galerkin.
+        /// Streamline-upwind Petrov-Galerkin, Habchi's Peclet number, strong residual with
+        /// the lubricant properties frozen inside each element (the default).
         Supg = "supg",
+        /// SUPG with the complete strong residual (fully consistent; needs meshes that
+        /// resolve the outlet pressure drop, Newton fails on the default mesh).
+        SupgExact = "supg-exact",
+        /// SUPG whose strong residual keeps only the Couette term (first-order consistent).
+        SupgCouette = "supg-couette",
         /// Plain Galerkin.
         Off = "none",
     } default = Supg
@@ -564,7 +570,7 @@ pub struct ReynoldsDomain {
     /// Dimensionless cavitation penalty factor xi (> 0): the term -xi min(P, 0) is added
     /// to the dimensionless Reynolds residual; default 1e4.
     pub penalty: f64,
-    /// "supg" | "none"; default "supg".
+    /// "supg" | "supg-exact" | "supg-couette" | "none"; default "supg".
     pub stabilisation: Stabilisation,
     /// Isotropic artificial diffusion factor delta_ID >= 0 (Habchi et al.): eps_ID =
     /// delta_ID h_e |(d rho_bar/dP) H u_bar| is added to the Reynolds diffusion coefficient;

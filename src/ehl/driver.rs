@@ -11,7 +11,7 @@
 //! the condensed (P, H0) one; `EHL_PTC=1` (with `EHL_PTC_DT0`) tries pseudo-transient
 //! continuation before the load continuation; `EHL_SKIP_PLAIN=1` skips the plain Newton
 //! attempt. `EHL_P1ISO=1` (condensed path) uses linear pressure on the P2 sub-triangles;
-//! `EHL_SUPG_COUETTE=1` keeps only the Couette part in the SUPG strong residual;
+//! `EHL_ID_CROSSWIND=1` makes `reynolds.artificial_diffusion` act crosswind only;
 //! `EHL_SUPG_DELTA` scales the SUPG parameter tau (default 1).
 //! With `EHL_DEBUG=1` the condensed path prints its worst residual rows and appends
 //! the iterates' centre lines to /tmp/ehl_debug_lines.csv.
@@ -88,18 +88,34 @@ fn ehl_params(scene: &Scene, nu: f64, half: bool) -> EhlParams {
     let scales = scene.scales();
     let kin = scene.kinematics().expect("lubricated scene");
     let (a, ue) = (scales.a, scene.operating.entrainment_speed.unwrap());
+    let penalty = if scene.effects.cavitation == crate::case::CavitationModel::Penalty { scene.reynolds.penalty } else { 0.0 };
     EhlParams {
         lambda_bar: lambda_bar(scene),
         traction: assembly::traction_factor(nu),
         load: if half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 },
-        penalty: if scene.effects.cavitation == crate::case::CavitationModel::Penalty { scene.reynolds.penalty } else { 0.0 },
-        stabilisation: crate::reynolds::element::Stabilisation {
-            supg: scene.reynolds.stabilisation == crate::case::Stabilisation::Supg,
-            delta: std::env::var("EHL_SUPG_DELTA").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0),
-            id: scene.reynolds.artificial_diffusion,
-        },
+        penalty,
+        stabilisation: stabilisation(scene, penalty),
         velocity: Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue]),
         nu,
+    }
+}
+
+/// The Reynolds element's stabilisation for the scene's `reynolds.stabilisation`.
+fn stabilisation(scene: &Scene, penalty: f64) -> crate::reynolds::element::Stabilisation {
+    use crate::case::Stabilisation as S;
+    use crate::reynolds::element::{Stabilisation, StrongResidual};
+    let choice = scene.reynolds.stabilisation;
+    Stabilisation {
+        supg: choice != S::Off,
+        delta: std::env::var("EHL_SUPG_DELTA").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0),
+        id: scene.reynolds.artificial_diffusion,
+        penalty,
+        residual: match choice {
+            S::SupgExact => StrongResidual::Full,
+            S::SupgCouette => StrongResidual::Couette,
+            _ => StrongResidual::FrozenLubricant,
+        },
+        film_peclet: true,
     }
 }
 
@@ -419,6 +435,22 @@ pub fn check_jacobian(system: &mut EhlSystem, layout: &Layout, rank: usize, x0: 
         if i - layout.ranges[r] < layout.n_u[r] { 0 } else { 1 }
     };
     let names = ["U", "P", "H0"];
+    // A generic point near the start: the Hertz start has P = 0 exactly at every node
+    // outside the Hertz circle, on the kink of the cavitation penalty (pen'' jumps from
+    // 1/delta to 0), where central differences straddle the kink and are wrong by
+    // xi h / (4 delta). A P-perturbation of 1e-3 >> the FD step moves every node off it
+    // (and puts some inside the penalty's quadratic zone, so that is checked too).
+    let mut seed0: u64 = 987654321;
+    let x0: Vec<f64> = x0
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            seed0 = seed0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let r = ((seed0 >> 11) as f64 / (1u64 << 53) as f64) - 0.5;
+            if block_of(i) == 1 { v + 2e-3 * r } else { v }
+        })
+        .collect();
+    let x0 = &x0[..];
     system.jacobian(x0, j)?;
     j.assemble()?;
     let (lo, hi) = (layout.ranges[rank], layout.ranges[rank + 1]);

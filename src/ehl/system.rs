@@ -37,19 +37,7 @@ pub fn p2_tri_weights(area: f64) -> [f64; 6] {
     [0.0, 0.0, 0.0, area / 3.0, area / 3.0, area / 3.0]
 }
 
-/// Width delta (in units of p_H) of the smoothed cavitation penalty; 0 gives the plain
-/// min(P, 0).
-pub const CAVITATION_SMOOTHING: f64 = 1e-3;
-
-/// The cavitation penalty function and its derivative: (P - sqrt(P^2 + delta^2))/2, a smooth
-/// version of min(P, 0) (equal to it up to O(delta^2 / |P|)).
-pub fn penalty_law(p: f64) -> (f64, f64) {
-    if CAVITATION_SMOOTHING == 0.0 {
-        return if p < 0.0 { (p, 1.0) } else { (0.0, 0.0) };
-    }
-    let r = (p * p + CAVITATION_SMOOTHING * CAVITATION_SMOOTHING).sqrt();
-    (0.5 * (p - r), 0.5 * (1.0 - p / r))
-}
+pub use crate::reynolds::cavitation::{penalty_law, CAVITATION_SMOOTHING};
 
 /// Lubricant laws in dimensionless form: eta_bar(P), rho_bar(P) with their P-derivatives.
 pub struct Lubricant {

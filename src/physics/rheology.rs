@@ -3,8 +3,9 @@
 //!
 //! Negative pressures: the penalty cavitation model lets p be slightly negative, and a
 //! Newton iterate may overshoot far below zero. Every law below is defined for all p; for
-//! p < 0 the pressure-dependent part saturates smoothly: ln(eta/eta_R) = s P_N tanh(p/P_N)
-//! and rho/rho_R = 1 + s' P_N tanh(p/P_N), with s, s' the slopes at p = 0 and
+//! p < 0 the pressure-dependent part saturates smoothly: ln(eta/eta_R) = f_eta(p) and
+//! rho/rho_R = 1 + f_rho(p), each f(p) = s P_N tanh(p/P_N) + (c P_N^2/2) u^2/(1+u^2), u = p/P_N,
+//! with s, c the slope and curvature at p = 0 (so the laws are C2 there) and
 //! P_N = [`NEGATIVE_PRESSURE_SCALE`]. Value and first derivative are continuous at p = 0,
 //! and the properties stay within a few per cent of their ambient values however negative
 //! p gets (a plain tangent let eta fall like exp(alpha p): an overshoot to -4 GPa gave
@@ -13,12 +14,23 @@
 /// Pressure scale P_N (Pa) over which the laws saturate for p < 0 (see the module doc).
 pub const NEGATIVE_PRESSURE_SCALE: f64 = 1e7;
 
-/// (s P_N tanh(p/P_N), its first and second derivatives): the saturated extension for p < 0
-/// of a law with slope s at p = 0.
-fn saturated(slope: f64, p: f64) -> (f64, f64, f64) {
-    let t = (p / NEGATIVE_PRESSURE_SCALE).tanh();
+/// The saturated extension for p < 0 of a law with slope s and curvature c at p = 0, with
+/// its first and second derivatives:
+/// f = s P_N tanh(u) + (c P_N^2 / 2) u^2 / (1 + u^2), u = p / P_N.
+/// f(0) = 0, f'(0) = s, f''(0) = c (C2 at p = 0, so the exact Jacobian of the SUPG term,
+/// which differentiates the laws' first derivatives, is continuous there); bounded by
+/// |s| P_N + |c| P_N^2 / 2 however negative p gets.
+fn saturated(slope: f64, curvature: f64, p: f64) -> (f64, f64, f64) {
+    let pn = NEGATIVE_PRESSURE_SCALE;
+    let u = p / pn;
+    let t = u.tanh();
     let sech2 = 1.0 - t * t;
-    (slope * NEGATIVE_PRESSURE_SCALE * t, slope * sech2, -2.0 * slope / NEGATIVE_PRESSURE_SCALE * sech2 * t)
+    let w = 1.0 + u * u;
+    (
+        slope * pn * t + 0.5 * curvature * pn * pn * u * u / w,
+        slope * sech2 + curvature * pn * u / (w * w),
+        -2.0 * slope / pn * sech2 * t + curvature * (1.0 - 3.0 * u * u) / (w * w * w),
+    )
 }
 
 /// Default Roelands reference pressure P_R (Pa).
@@ -109,7 +121,7 @@ impl ViscosityLaw {
             ViscosityLaw::Constant { .. } => (0.0, 0.0),
             ViscosityLaw::Barus { alpha, .. } if p >= 0.0 => (alpha * p, alpha),
             ViscosityLaw::Barus { alpha, .. } => {
-                let (v, d, _) = saturated(alpha, p);
+                let (v, d, _) = saturated(alpha, 0.0, p);
                 (v, d)
             }
             ViscosityLaw::Roelands { eta_r, p_r, z_r } => {
@@ -119,7 +131,7 @@ impl ViscosityLaw {
                     let tz1 = t.powf(z_r - 1.0);
                     (s * (t * tz1 - 1.0), s * z_r * tz1 / p_r)
                 } else {
-                    let (v, d, _) = saturated(s * z_r / p_r, p);
+                    let (v, d, _) = saturated(s * z_r / p_r, s * z_r * (z_r - 1.0) / (p_r * p_r), p);
                     (v, d)
                 }
             }
@@ -155,9 +167,9 @@ impl ViscosityLaw {
             }
             ViscosityLaw::Roelands { eta_r, p_r, z_r } => {
                 let s = eta_r.ln() - ROELANDS_LN_ETA_INFINITY;
-                saturated(s * z_r / p_r, p).2
+                saturated(s * z_r / p_r, s * z_r * (z_r - 1.0) / (p_r * p_r), p).2
             }
-            ViscosityLaw::Barus { alpha, .. } if p < 0.0 => saturated(alpha, p).2,
+            ViscosityLaw::Barus { alpha, .. } if p < 0.0 => saturated(alpha, 0.0, p).2,
             _ => 0.0,
         };
         eta * (g * g + dg)
@@ -204,7 +216,7 @@ impl DensityLaw {
                     let d = c1 + p;
                     ((c1 + c2 * p) / d, (c2 - 1.0) * c1 / (d * d))
                 } else {
-                    let (v, d, _) = saturated((c2 - 1.0) / c1, p);
+                    let (v, d, _) = saturated((c2 - 1.0) / c1, -2.0 * (c2 - 1.0) / (c1 * c1), p);
                     (1.0 + v, d)
                 }
             }
@@ -219,7 +231,10 @@ impl DensityLaw {
                 let d = c1 + p;
                 -2.0 * (c2 - 1.0) * c1 / (d * d * d)
             }
-            DensityLaw::DowsonHigginson { .. } => saturated((DOWSON_HIGGINSON_C2 - 1.0) / DOWSON_HIGGINSON_C1, p).2,
+            DensityLaw::DowsonHigginson { .. } => {
+                let (c1, c2) = (DOWSON_HIGGINSON_C1, DOWSON_HIGGINSON_C2);
+                saturated((c2 - 1.0) / c1, -2.0 * (c2 - 1.0) / (c1 * c1), p).2
+            }
             _ => 0.0,
         }
     }
@@ -237,6 +252,28 @@ impl DensityLaw {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn negative_pressure_extension_is_c2_at_zero() {
+        let visc = ViscosityLaw::Roelands { eta_r: 0.012, p_r: 1.96e8, z_r: 0.8591 };
+        let dens = DensityLaw::DowsonHigginson { rho_r: 870.0 };
+        let e = 1e-3; // Pa
+        for (a, b) in [
+            (visc.viscosity_second_derivative(e), visc.viscosity_second_derivative(-e)),
+            (dens.ratio_second_derivative(e), dens.ratio_second_derivative(-e)),
+        ] {
+            assert!((a - b).abs() <= 1e-6 * a.abs(), "second derivative jumps at p = 0: {a:e} vs {b:e}");
+        }
+        // and the first derivatives agree with central differences of the values below zero
+        let p = -3e6;
+        let h = 1e2;
+        let fd = (visc.viscosity(p + h) - visc.viscosity(p - h)) / (2.0 * h);
+        assert!((fd / visc.viscosity_derivative(p) - 1.0).abs() < 1e-6);
+        let fd2 = (visc.viscosity_derivative(p + h) - visc.viscosity_derivative(p - h)) / (2.0 * h);
+        assert!((fd2 / visc.viscosity_second_derivative(p) - 1.0).abs() < 1e-5);
+        let fdr = (dens.ratio_and_derivative(p + h).1 - dens.ratio_and_derivative(p - h).1) / (2.0 * h);
+        assert!((fdr / dens.ratio_second_derivative(p) - 1.0).abs() < 1e-5);
+    }
+
     use super::*;
     use crate::physics::test_util::{fd, rel};
 

@@ -62,15 +62,40 @@ pub struct Stabilisation {
     /// the diffusion coefficient of the Galerkin term, with beta = (d rho_bar/dP) H v the
     /// convection velocity of P in the Couette term. Inconsistent by O(h): 0 switches it off.
     pub id: f64,
+    /// Cavitation penalty factor xi of the equation (0: none). The caller adds the lumped
+    /// penalty xi area_i pen(P_i) to row i; the SUPG strong residual needs the same term as
+    /// a field, xi sum_j pen(P_j) N_j, or SUPG is inconsistent where the film cavitates
+    /// (there the penalty, not the Reynolds operator, balances div(rho H v)).
+    pub penalty: f64,
+    /// Which terms the strong residual keeps (see [`StrongResidual`]).
+    pub residual: StrongResidual,
+    /// Peclet number (and so tau) on Habchi's convection velocity beta = (d rho_bar/dP) H v
+    /// instead of v (see the module documentation).
+    pub film_peclet: bool,
+}
+
+/// The terms of the SUPG strong residual r = div(rho_bar H v) - div(eps grad P) + penalty.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StrongResidual {
+    /// Every term: the exact residual of the discrete fields (fully consistent).
+    Full,
+    /// div(eps grad P) with the lubricant properties frozen inside the element:
+    /// eps Lap P + (d eps/dH) grad H . grad P, without (d eps/dP) |grad P|^2.
+    FrozenLubricant,
+    /// The Couette (and penalty) part only: streamline diffusion of the Couette flux.
+    Couette,
 }
 
 impl Default for Stabilisation {
-    /// SUPG on, delta = 1.
+    /// SUPG on, delta = 1, full strong residual, Pe on |v|.
     fn default() -> Self {
         Self {
             supg: true,
             delta: 1.0,
             id: 0.0,
+            penalty: 0.0,
+            residual: StrongResidual::Full,
+            film_peclet: false,
         }
     }
 }
@@ -78,15 +103,11 @@ impl Default for Stabilisation {
 impl Stabilisation {
     /// Plain Galerkin.
     pub fn none() -> Self {
-        Self {
-            supg: false,
-            delta: 1.0,
-            id: 0.0,
-        }
+        Self { supg: false, ..Self::default() }
     }
     /// SUPG with multiplier `delta`.
     pub fn supg(delta: f64) -> Self {
-        Self { supg: true, delta, id: 0.0 }
+        Self { delta, ..Self::default() }
     }
 }
 
@@ -183,6 +204,16 @@ pub fn reynolds_element_with_source(
         .map(|k| vel[k][0] * tri.grad_l[k][0] + vel[k][1] * tri.grad_l[k][1])
         .sum();
 
+    // Nodal cavitation penalty xi pen(P_j), interpolated in the SUPG strong residual.
+    let pen_nodes: [D12; 6] = std::array::from_fn(|j| {
+        if stab.supg && stab.penalty > 0.0 {
+            let (v, d) = super::cavitation::penalty_law(p[j]);
+            pd[j].chain(v, d) * stab.penalty
+        } else {
+            D12::constant(0.0)
+        }
+    });
+
     let mut res = [D12::constant(0.0); 6];
     for q in DUNAVANT6.iter() {
         let l = &q.l;
@@ -221,19 +252,27 @@ pub fn reynolds_element_with_source(
         let v_dn: [f64; 6] = std::array::from_fn(|i| v[0] * dn[i][0] + v[1] * dn[i][1]);
         // Isotropic artificial diffusion eps_id = id h_e |rho' H v| (exact derivative through
         // the duals: rho' is a dual built from rho'').
-        let eps_g = if stab.id > 0.0 {
-            let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
+        let crosswind = crosswind_diffusion();
+        let vn0 = (v[0] * v[0] + v[1] * v[1]).sqrt();
+        let eps_a = if stab.id > 0.0 {
             let h_e = streamline_length(&tri, v);
             let drho_d = pq.chain(drho, (fluid.d2rho)(pq.v));
-            let beta = drho_d * hq * vn;
+            let beta = drho_d * hq * vn0;
             let beta_abs = if beta.v < 0.0 { -beta } else { beta };
-            eps + beta_abs * (stab.id * h_e)
+            beta_abs * (stab.id * h_e)
         } else {
-            eps
+            D12::constant(0.0)
         };
+        let eps_g = if crosswind { eps } else { eps + eps_a };
         for i in 0..6 {
             let flux = gp[0] * dn[i][0] + gp[1] * dn[i][1];
             res[i] += (eps_g * flux - rho_h * v_dn[i] - f * n[i]) * wq;
+            if crosswind && stab.id > 0.0 && vn0 > 0.0 {
+                // crosswind only: grad P . grad N - (t . grad P)(t . grad N), t = v/|v|
+                let (tx, tz) = (v[0] / vn0, v[1] / vn0);
+                let cw = flux - (gp[0] * tx + gp[1] * tz) * (dn[i][0] * tx + dn[i][1] * tz);
+                res[i] += eps_a * cw * wq;
+            }
         }
 
         if stab.supg {
@@ -246,6 +285,8 @@ pub fn reynolds_element_with_source(
             let drho_d = pq.chain(drho, (fluid.d2rho)(pq.v));
             let eps_p = eps * (drho_d / rho_d - deta_d / eta_d);
             let eps_h = rho_d * hq * hq * 3.0 / (eta_d * fluid.lambda_bar); // 3 eps / H, no division by H
+            // StrongResidual::FrozenLubricant drops the lubricant-property gradient eps_P grad P.
+            let eps_p = if stab.residual == StrongResidual::Full { eps_p } else { D12::constant(0.0) };
             let g_eps = [eps_p * gp[0] + eps_h * gh[0], eps_p * gp[1] + eps_h * gh[1]];
             let div_flux = eps * lap_p + g_eps[0] * gp[0] + g_eps[1] * gp[1];
             // div(rho H v) = v . grad(rho H) + rho H div v, grad(rho H) = rho' H grad P + rho grad H
@@ -253,13 +294,22 @@ pub fn reynolds_element_with_source(
             let conv = (drho_h * gp[0] + rho_d * gh[0]) * v[0]
                 + (drho_h * gp[1] + rho_d * gh[1]) * v[1]
                 + rho_h * div_v;
-            // Developer experiment (EHL_SUPG_COUETTE=1): streamline diffusion of the Couette
-            // flux only, dropping the Poiseuille part of the strong residual.
-            let r_strong = if couette_only() { conv - f } else { conv - div_flux - f };
+            let mut pen = D12::constant(0.0);
+            for j in 0..6 {
+                pen += pen_nodes[j] * n[j];
+            }
+            let r_strong = match stab.residual {
+                StrongResidual::Couette => conv + pen - f,
+                _ => conv - div_flux + pen - f,
+            };
 
             // tau = delta h_e / (2|v|) xi(Pe), Pe = |v| h_e / (2 eps), h_e = streamline length
             let h_e = streamline_length(&tri, v);
-            let pe = (vn * h_e * 0.5) / eps;
+            // Pe on |v| (plain SUPG) or on Habchi's |beta| = (d rho_bar/dP) H |v| (the
+            // convection velocity of P in the Couette term); an incompressible lubricant has
+            // no beta, and falls back to |v|.
+            let pe_v = (vn * h_e * 0.5) / eps;
+            let pe = if stab.film_peclet && drho_d.v != 0.0 { pe_v * drho_d * hq } else { pe_v };
             let (xv, dxv) = xi(pe.v);
             let tau = pe.chain(xv, dxv) * (stab.delta * h_e / (2.0 * vn));
             let t_r = tau * r_strong * wq;
@@ -282,7 +332,9 @@ pub fn reynolds_element_with_source(
     out
 }
 
-fn couette_only() -> bool {
+/// Developer experiment (`EHL_ID_CROSSWIND=1`): the artificial diffusion acts crosswind only
+/// (grad P . grad N_i minus its streamline part).
+fn crosswind_diffusion() -> bool {
     static FLAG: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    *FLAG.get_or_init(|| std::env::var_os("EHL_SUPG_COUETTE").is_some())
+    *FLAG.get_or_init(|| std::env::var_os("EHL_ID_CROSSWIND").is_some())
 }

@@ -60,6 +60,17 @@
 //! diffusion dominates) and xi -> 1 for large Pe (tau -> delta h_e / (2|v|)).
 //! delta (default 1) scales tau.
 //!
+//! ## Variants used by the EHL solver ([`element::StrongResidual`], `film_peclet`)
+//! - `film_peclet`: Pe = |beta| h_e / (2 eps) with Habchi's beta = (d rho_bar/dP) H v (the
+//!   convection velocity of P in the Couette term), tau = delta h_e/(2|v|) xi(Pe): SUPG acts
+//!   only where the Couette term dominates (an incompressible lubricant falls back to |v|).
+//! - `StrongResidual::FrozenLubricant` (the solver's default) drops (d eps/dP) |grad P|^2
+//!   from r_strong. Its linearisation is a streamline anti-diffusion at the outlet (grad P
+//!   against v) about 20 times the physical diffusion on the default mesh, and Newton
+//!   stalls with it; without it the manufactured-solution order is 2 instead of 3.
+//! - `StrongResidual::Couette` keeps only div(rho_bar H v) (and the penalty): first order.
+//! - The cavitation penalty xi pen(P) enters r_strong when [`Stabilisation::penalty`] > 0.
+//!
 //! # Exact Jacobian
 //! The residual is computed once over [`dual::Dual`]`<12>` numbers seeded with the 12
 //! element unknowns (P_0..P_5, then H_0..H_5), giving dR_i/dP_j and dR_i/dH_j exactly,
@@ -75,6 +86,7 @@
 // Index loops mirror the formulas (N_i, dR_i/dP_j) in this numeric code.
 #![allow(clippy::needless_range_loop)]
 
+pub mod cavitation;
 pub mod dual;
 pub mod element;
 pub mod p1;
