@@ -1,5 +1,5 @@
-//! A lubricated run that converges end to end (light load, coarse mesh, with the optional
-//! isotropic artificial diffusion on, so that path runs too) under 2 MPI ranks: the load balance
+//! A lubricated run that converges end to end (light load, coarse mesh, default SUPG)
+//! under 2 MPI ranks: the load balance
 //! closes, and every output the user looks at is written: summary.json, the two profile
 //! CSVs, the PNG maps and profiles, the contact-face VTU.
 //! This checks the pipeline, not the film values (see README "Lubricated solver: state").
@@ -12,7 +12,7 @@ fn converged_lubricated_run_writes_all_outputs() {
     let base = std::fs::read_to_string(repo().join("cases/paper/table2-ue2.toml")).unwrap();
     let scene = base
         .replace("load = 1500.0", "load = 100.0")
-        .replace("[output]", "[mesh]\ncontact_size = 0.5\n\n[reynolds]\nartificial_diffusion = 10\n\n[output]");
+        .replace("[output]", "[mesh]\ncontact_size = 0.5\n\n[output]");
     let path = write_scene(&dir, "scene.toml", &scene);
     let out_dir = dir.join("out");
     let out = mpirun(2, &[path.as_str(), "--output", out_dir.to_str().unwrap()]);
