@@ -191,7 +191,7 @@ impl<'a> CondensedSystem<'a> {
         if !e.linear {
             return reynolds_element(&e.verts, p, h, &e.vel, fluid, &self.params.stabilisation);
         }
-        let (r, dp, dh) = crate::reynolds::p1::reynolds_p1_element(&e.verts, &[p[0], p[1], p[2]], &[h[0], h[1], h[2]], &e.vel, fluid);
+        let (r, dp, dh) = crate::reynolds::p1::reynolds_p1_element_stab(&e.verts, &[p[0], p[1], p[2]], &[h[0], h[1], h[2]], &e.vel, fluid, &self.params.stabilisation);
         let mut out = ElementOut { r: [0.0; 6], dr_dp: [[0.0; 6]; 6], dr_dh: [[0.0; 6]; 6] };
         for i in 0..3 {
             out.r[i] = r[i];

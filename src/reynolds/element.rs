@@ -158,6 +158,17 @@ pub fn streamline_length(tri: &P2Triangle, v: [f64; 2]) -> f64 {
     2.0 * vn / s
 }
 
+/// Streamline length from the barycentric gradients `g` of a triangle (see
+/// [`streamline_length`]).
+pub fn streamline_length_p1(g: &[[f64; 2]; 3], v: [f64; 2]) -> f64 {
+    let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
+    if vn == 0.0 {
+        return 0.0;
+    }
+    let s: f64 = g.iter().map(|g| (v[0] * g[0] + v[1] * g[1]).abs()).sum();
+    2.0 * vn / s
+}
+
 /// Element residual and exact Jacobian of the Reynolds equation (no source term).
 ///
 /// `verts`: the 3 vertices; `p`, `h`: nodal P and H (order v0, v1, v2, m01, m12, m20);

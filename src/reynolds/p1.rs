@@ -1,5 +1,5 @@
-//! Linear (P1) Galerkin element of the dimensionless Reynolds equation on one straight
-//! triangle, with its exact Jacobian (forward-mode duals over the 3 nodal P and 3 nodal H):
+//! Linear (P1) element of the dimensionless Reynolds equation on one straight triangle
+//! (Galerkin, optionally with the SUPG of [`super::element`]), with its exact Jacobian (forward-mode duals over the 3 nodal P and 3 nodal H):
 //! ```text
 //!   R_i = int_T [ eps grad P . grad L_i - rho_bar H (v . grad L_i) ],
 //!   eps = rho_bar H^3 / (eta_bar lambda_bar).
@@ -8,13 +8,19 @@
 //! nodes as P2, but every basis function integrates to area/3 > 0, so every nodal pressure
 //! carries load (a P2 vertex function integrates to zero).
 use super::dual::Dual;
-use super::element::Fluid;
+use super::element::{streamline_length_p1, xi, Fluid, Stabilisation, StrongResidual};
 use super::quadrature::DUNAVANT6;
 
 type D6 = Dual<6>;
 
 /// Residual, dR/dP and dR/dH of one P1 triangle. `vel`: entrainment at the 3 vertices.
 pub fn reynolds_p1_element(verts: &[[f64; 2]; 3], p: &[f64; 3], h: &[f64; 3], vel: &[[f64; 2]; 3], fluid: &Fluid) -> ([f64; 3], [[f64; 3]; 3], [[f64; 3]; 3]) {
+    reynolds_p1_element_stab(verts, p, h, vel, fluid, &Stabilisation::none())
+}
+
+/// As [`reynolds_p1_element`], with the SUPG term of [`Stabilisation`] (P is linear, so
+/// Lap P = 0 in the strong residual; the penalty enters it interpolated linearly).
+pub fn reynolds_p1_element_stab(verts: &[[f64; 2]; 3], p: &[f64; 3], h: &[f64; 3], vel: &[[f64; 2]; 3], fluid: &Fluid, stab: &Stabilisation) -> ([f64; 3], [[f64; 3]; 3], [[f64; 3]; 3]) {
     let (x, z) = (verts.map(|v| v[0]), verts.map(|v| v[1]));
     let det = (x[1] - x[0]) * (z[2] - z[0]) - (x[2] - x[0]) * (z[1] - z[0]);
     let area = 0.5 * det.abs();
@@ -52,6 +58,46 @@ pub fn reynolds_p1_element(verts: &[[f64; 2]; 3], p: &[f64; 3], h: &[f64; 3], ve
             let flux = gp[0] * g[i][0] + gp[1] * g[i][1];
             let vg = v[0] * g[i][0] + v[1] * g[i][1];
             res[i] += (eps * flux - rho_h * vg) * wq;
+        }
+        if stab.supg {
+            let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
+            if vn == 0.0 {
+                continue;
+            }
+            let drho_d = pq.chain(drho, (fluid.d2rho)(pq.v));
+            let deta_d = pq.chain(deta, (fluid.d2eta)(pq.v));
+            let mut gh = [D6::constant(0.0); 2];
+            for j in 0..3 {
+                for c in 0..2 {
+                    gh[c] += hd[j] * g[j][c];
+                }
+            }
+            let eps_h = rho_d * hq * hq * 3.0 / (eta_d * fluid.lambda_bar);
+            let eps_p = if stab.residual == StrongResidual::Full { eps * (drho_d / rho_d - deta_d / eta_d) } else { D6::constant(0.0) };
+            let div_flux = (eps_p * gp[0] + eps_h * gh[0]) * gp[0] + (eps_p * gp[1] + eps_h * gh[1]) * gp[1];
+            let drho_h = drho_d * hq;
+            let div_v: f64 = (0..3).map(|k| vel[k][0] * g[k][0] + vel[k][1] * g[k][1]).sum();
+            let conv = (drho_h * gp[0] + rho_d * gh[0]) * v[0] + (drho_h * gp[1] + rho_d * gh[1]) * v[1] + rho_h * div_v;
+            let mut pen = D6::constant(0.0);
+            if stab.penalty > 0.0 {
+                for j in 0..3 {
+                    let (pv, pdv) = super::cavitation::penalty_law(p[j]);
+                    pen += pd[j].chain(pv, pdv) * (stab.penalty * l[j]);
+                }
+            }
+            let r_strong = match stab.residual {
+                StrongResidual::Couette => conv + pen,
+                _ => conv - div_flux + pen,
+            };
+            let h_e = streamline_length_p1(&g, v);
+            let pe_v = (vn * h_e * 0.5) / eps;
+            let pe = if stab.film_peclet && drho_d.v != 0.0 { pe_v * drho_d * hq } else { pe_v };
+            let (xv, dxv) = xi(pe.v);
+            let tau = pe.chain(xv, dxv) * (stab.delta * h_e / (2.0 * vn));
+            let t_r = tau * r_strong * wq;
+            for i in 0..3 {
+                res[i] += t_r * (v[0] * g[i][0] + v[1] * g[i][1]);
+            }
         }
     }
     let r = res.map(|d| d.v);
@@ -92,6 +138,40 @@ mod tests {
             for i in 0..3 {
                 assert!((dp[i][j] - (rp[i] - rm[i]) / (2.0 * d)).abs() < 1e-7 * (1.0 + dp[i][j].abs()));
                 assert!((dh[i][j] - (sp[i] - sm[i]) / (2.0 * d)).abs() < 1e-7 * (1.0 + dh[i][j].abs()));
+            }
+        }
+    }
+
+    #[test]
+    fn supg_jacobian_matches_central_differences() {
+        let eta = |p: f64| ((2.0 * p).exp(), 2.0 * (2.0 * p).exp());
+        let d2eta = |p: f64| 4.0 * (2.0 * p).exp();
+        let rho = |p: f64| ((1.0 + 2.0 * p) / (1.0 + p), 1.0 / ((1.0 + p) * (1.0 + p)));
+        let d2rho = |p: f64| -2.0 / ((1.0 + p) * (1.0 + p) * (1.0 + p));
+        let fluid = Fluid { eta: &eta, rho: &rho, d2eta: &d2eta, d2rho: &d2rho, lambda_bar: 0.3 };
+        let verts = [[0.1, -0.2], [0.6, 0.05], [0.2, 0.4]];
+        let vel = [[1.0, 0.1], [0.9, -0.2], [1.1, 0.0]];
+        // one node inside the penalty's quadratic zone, one below it
+        let (p, h) = ([0.3, -4e-4, -0.05], [0.4, 0.25, 0.6]);
+        for residual in [StrongResidual::Full, StrongResidual::FrozenLubricant, StrongResidual::Couette] {
+            let stab = Stabilisation { residual, film_peclet: true, penalty: 30.0, ..Stabilisation::default() };
+            let (_, dp, dh) = reynolds_p1_element_stab(&verts, &p, &h, &vel, &fluid, &stab);
+            let d = 1e-7;
+            for j in 0..3 {
+                let (mut pp, mut pm) = (p, p);
+                pp[j] += d;
+                pm[j] -= d;
+                let (rp, _, _) = reynolds_p1_element_stab(&verts, &pp, &h, &vel, &fluid, &stab);
+                let (rm, _, _) = reynolds_p1_element_stab(&verts, &pm, &h, &vel, &fluid, &stab);
+                let (mut hp, mut hm) = (h, h);
+                hp[j] += d;
+                hm[j] -= d;
+                let (sp, _, _) = reynolds_p1_element_stab(&verts, &p, &hp, &vel, &fluid, &stab);
+                let (sm, _, _) = reynolds_p1_element_stab(&verts, &p, &hm, &vel, &fluid, &stab);
+                for i in 0..3 {
+                    assert!((dp[i][j] - (rp[i] - rm[i]) / (2.0 * d)).abs() < 1e-6 * (1.0 + dp[i][j].abs()), "{residual:?} dP {i} {j}");
+                    assert!((dh[i][j] - (sp[i] - sm[i]) / (2.0 * d)).abs() < 1e-6 * (1.0 + dh[i][j].abs()), "{residual:?} dH {i} {j}");
+                }
             }
         }
     }
