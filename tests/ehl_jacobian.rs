@@ -6,8 +6,7 @@ use common::*;
 #[test]
 fn ehl_jacobian_matches_finite_differences() {
     let dir = scratch("ehl-jacobian");
-    let base = std::fs::read_to_string(repo().join("cases/paper/table2-ue2.toml")).unwrap();
-    let scene = base.replace("[output]", "[mesh]\ncontact_size = 1.0\ngrowth = 2.0\n\n[output]");
+    let scene = table2_ue2_with_mesh("contact_size = 1.0\ngrowth = 2.0");
     let path = write_scene(&dir, "scene.toml", &scene);
     let mut cmd = std::process::Command::new("mpirun");
     cmd.args(["-n", "2"]).arg(binary()).args([path.as_str(), "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "0"]);
@@ -33,8 +32,7 @@ fn ehl_jacobian_matches_finite_differences() {
 /// norms it printed (the whole continuation path).
 fn newton_norms(tag: &str, monolithic: bool) -> Vec<f64> {
     let dir = scratch(tag);
-    let base = std::fs::read_to_string(repo().join("cases/paper/table2-ue2.toml")).unwrap();
-    let scene = base.replace("[output]", "[mesh]\ncontact_size = 1.0\ngrowth = 2.0\n\n[output]");
+    let scene = table2_ue2_with_mesh("contact_size = 1.0\ngrowth = 2.0");
     let path = write_scene(&dir, "scene.toml", &scene);
     let mut cmd = std::process::Command::new("mpirun");
     cmd.args(["-n", "2"]).arg(binary()).args([path.as_str(), "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "3", "-snes_monitor"]);

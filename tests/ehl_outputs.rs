@@ -9,10 +9,7 @@ use common::*;
 #[test]
 fn converged_lubricated_run_writes_all_outputs() {
     let dir = scratch("ehl-outputs");
-    let base = std::fs::read_to_string(repo().join("cases/paper/table2-ue2.toml")).unwrap();
-    let scene = base
-        .replace("load = 1500.0", "load = 100.0")
-        .replace("[output]", "[mesh]\ncontact_size = 0.5\n\n[output]");
+    let scene = table2_ue2_with_mesh("contact_size = 0.5").replace("load = 1500.0", "load = 100.0");
     let path = write_scene(&dir, "scene.toml", &scene);
     let out_dir = dir.join("out");
     let out = mpirun(2, &[path.as_str(), "--output", out_dir.to_str().unwrap()]);

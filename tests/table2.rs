@@ -1,5 +1,5 @@
-//! Table 2 of the paper (pure rolling, Ue = 2 m/s, L = 1500 N) on the default mesh under
-//! 2 MPI ranks: Newton converges from the Hertz start with the default SUPG, the load
+//! Table 2 of the paper (pure rolling, Ue = 2 m/s, L = 1500 N) on the scene's mesh (0.25 a,
+//! core of 0.125 a over |X|, |Z| <= 1.25) under 2 MPI ranks (about 2 minutes): Newton converges from the Hertz start with the default SUPG, the load
 //! balance closes, and hc, hm land near the paper's FEM values.
 //!
 //! Tolerances: the acceptance bands around the paper's FEM values (hc 0.40 um

@@ -72,3 +72,12 @@ pub fn num(v: &serde_json::Value, path: &str) -> f64 {
     }
     cur.as_f64().unwrap_or_else(|| panic!("{path} is not a number in {v}"))
 }
+
+/// The Table 2 (Ue = 2 m/s) paper scene with its `[mesh]` section replaced by `mesh`
+/// (the TOML lines of the new section, without the header).
+pub fn table2_ue2_with_mesh(mesh: &str) -> String {
+    let base = std::fs::read_to_string(repo().join("cases/paper/table2-ue2.toml")).unwrap();
+    let start = base.find("[mesh]\n").expect("table2-ue2 has a [mesh] section");
+    let end = start + base[start..].find("\n\n").expect("[mesh] section ends with a blank line");
+    format!("{}[mesh]\n{}{}", &base[..start], mesh, &base[end..])
+}
