@@ -146,27 +146,28 @@ pub fn xi(pe: f64) -> (f64, f64) {
 /// Length of the triangle in the direction of `v` (Tezduyar's h_UGN):
 /// h_s = 2 |v| / sum_k |v . grad L_k|. Returns 0 for v = 0.
 pub fn streamline_length(tri: &P2Triangle, v: [f64; 2]) -> f64 {
-    let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
-    if vn == 0.0 {
-        return 0.0;
-    }
-    let s: f64 = tri
-        .grad_l
-        .iter()
-        .map(|g| (v[0] * g[0] + v[1] * g[1]).abs())
-        .sum();
-    2.0 * vn / s
+    streamline_length_from_gradients(&tri.grad_l, v)
 }
 
-/// Streamline length from the barycentric gradients `g` of a triangle (see
-/// [`streamline_length`]).
-pub fn streamline_length_p1(g: &[[f64; 2]; 3], v: [f64; 2]) -> f64 {
+/// [`streamline_length`] from the barycentric gradients `g` of a triangle.
+pub fn streamline_length_from_gradients(g: &[[f64; 2]; 3], v: [f64; 2]) -> f64 {
     let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
     if vn == 0.0 {
         return 0.0;
     }
     let s: f64 = g.iter().map(|g| (v[0] * g[0] + v[1] * g[1]).abs()).sum();
     2.0 * vn / s
+}
+
+/// SUPG parameter tau = delta h_e / (2|v|) xi(Pe) at a quadrature point (|v| = `vn` > 0),
+/// with Pe = |v| h_e / (2 eps), times (d rho_bar/dP) H when `stab.film_peclet` (Habchi's
+/// beta; an incompressible lubricant, drho = 0, keeps |v|). Shared by the P2 and P1
+/// elements; exact through the duals.
+pub fn supg_tau<const N: usize>(stab: &Stabilisation, vn: f64, h_e: f64, eps: Dual<N>, drho: Dual<N>, h: Dual<N>) -> Dual<N> {
+    let pe_v = (vn * h_e * 0.5) / eps;
+    let pe = if stab.film_peclet && drho.v != 0.0 { pe_v * drho * h } else { pe_v };
+    let (xv, dxv) = xi(pe.v);
+    pe.chain(xv, dxv) * (stab.delta * h_e / (2.0 * vn))
 }
 
 /// Element residual and exact Jacobian of the Reynolds equation (no source term).
@@ -314,15 +315,8 @@ pub fn reynolds_element_with_source(
                 _ => conv - div_flux + pen - f,
             };
 
-            // tau = delta h_e / (2|v|) xi(Pe), Pe = |v| h_e / (2 eps), h_e = streamline length
-            let h_e = streamline_length(&tri, v);
-            // Pe on |v| (plain SUPG) or on Habchi's |beta| = (d rho_bar/dP) H |v| (the
-            // convection velocity of P in the Couette term); an incompressible lubricant has
-            // no beta, and falls back to |v|.
-            let pe_v = (vn * h_e * 0.5) / eps;
-            let pe = if stab.film_peclet && drho_d.v != 0.0 { pe_v * drho_d * hq } else { pe_v };
-            let (xv, dxv) = xi(pe.v);
-            let tau = pe.chain(xv, dxv) * (stab.delta * h_e / (2.0 * vn));
+            // tau = delta h_e / (2|v|) xi(Pe), h_e = streamline length
+            let tau = supg_tau(stab, vn, streamline_length(&tri, v), eps, drho_d, hq);
             let t_r = tau * r_strong * wq;
             for i in 0..6 {
                 res[i] += t_r * v_dn[i];

@@ -8,7 +8,7 @@
 //! nodes as P2, but every basis function integrates to area/3 > 0, so every nodal pressure
 //! carries load (a P2 vertex function integrates to zero).
 use super::dual::Dual;
-use super::element::{streamline_length_p1, xi, Fluid, Stabilisation, StrongResidual};
+use super::element::{streamline_length_from_gradients, supg_tau, Fluid, Stabilisation, StrongResidual};
 use super::quadrature::DUNAVANT6;
 
 type D6 = Dual<6>;
@@ -89,11 +89,7 @@ pub fn reynolds_p1_element_stab(verts: &[[f64; 2]; 3], p: &[f64; 3], h: &[f64; 3
                 StrongResidual::Couette => conv + pen,
                 _ => conv - div_flux + pen,
             };
-            let h_e = streamline_length_p1(&g, v);
-            let pe_v = (vn * h_e * 0.5) / eps;
-            let pe = if stab.film_peclet && drho_d.v != 0.0 { pe_v * drho_d * hq } else { pe_v };
-            let (xv, dxv) = xi(pe.v);
-            let tau = pe.chain(xv, dxv) * (stab.delta * h_e / (2.0 * vn));
+            let tau = supg_tau(stab, vn, streamline_length_from_gradients(&g, v), eps, drho_d, hq);
             let t_r = tau * r_strong * wq;
             for i in 0..3 {
                 res[i] += t_r * (v[0] * g[i][0] + v[1] * g[i][1]);
