@@ -440,27 +440,18 @@ pub fn check_jacobian(system: &mut EhlSystem, layout: &Layout, rank: usize, x0: 
     // 1/delta to 0), where central differences straddle the kink and are wrong by
     // xi h / (4 delta). A P-perturbation of 1e-3 >> the FD step moves every node off it
     // (and puts some inside the penalty's quadratic zone, so that is checked too).
-    let mut seed0: u64 = 987654321;
-    let x0: Vec<f64> = x0
-        .iter()
-        .enumerate()
-        .map(|(i, &v)| {
-            seed0 = seed0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            let r = ((seed0 >> 11) as f64 / (1u64 << 53) as f64) - 0.5;
-            if block_of(i) == 1 { v + 2e-3 * r } else { v }
-        })
-        .collect();
-    let x0 = &x0[..];
-    system.jacobian(x0, j)?;
-    j.assemble()?;
-    let (lo, hi) = (layout.ranges[rank], layout.ranges[rank + 1]);
-    let mut out = Vec::new();
-    // Deterministic pseudo-random direction.
+    // Deterministic pseudo-random numbers in [-0.5, 0.5) for the point and the direction.
     let mut seed: u64 = 12345;
     let mut rnd = || {
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
     };
+    let x0: Vec<f64> = x0.iter().enumerate().map(|(i, &v)| v + if block_of(i) == 1 { 2e-3 * rnd() } else { 0.0 }).collect();
+    let x0 = &x0[..];
+    system.jacobian(x0, j)?;
+    j.assemble()?;
+    let (lo, hi) = (layout.ranges[rank], layout.ranges[rank + 1]);
+    let mut out = Vec::new();
     let dir_all: Vec<f64> = (0..n).map(|_| rnd()).collect();
     for cb in 0..3 {
         let v: Vec<f64> = (0..n).map(|i| if block_of(i) == cb { dir_all[i] } else { 0.0 }).collect();
