@@ -170,6 +170,43 @@ pub fn supg_tau<const N: usize>(stab: &Stabilisation, vn: f64, h_e: f64, eps: Du
     pe.chain(xv, dxv) * (stab.delta * h_e / (2.0 * vn))
 }
 
+/// The fields and lubricant properties at one quadrature point, as duals over the element
+/// unknowns (P2 or P1 element): what the SUPG strong residual needs.
+pub struct PointFields<const N: usize> {
+    /// H, grad P, grad H.
+    pub h: Dual<N>,
+    pub grad_p: [Dual<N>; 2],
+    pub grad_h: [Dual<N>; 2],
+    /// rho_bar, d rho_bar/dP, eta_bar, d eta_bar/dP (the derivatives as duals: they carry
+    /// rho'' and eta'').
+    pub rho: Dual<N>,
+    pub drho: Dual<N>,
+    pub eta: Dual<N>,
+    pub deta: Dual<N>,
+    /// eps = rho_bar H^3 / (eta_bar lambda_bar).
+    pub eps: Dual<N>,
+}
+
+/// SUPG strong residual r = div(rho_bar H v) - [eps Lap P + grad eps . grad P] + pen with
+/// the terms `stab.residual` keeps (see [`StrongResidual`]); `lap_p` is Lap P (0 for P1),
+/// `pen` the interpolated penalty xi pen(P). Shared by the P2 and P1 elements.
+pub fn strong_residual<const N: usize>(stab: &Stabilisation, q: &PointFields<N>, lambda_bar: f64, lap_p: Dual<N>, v: [f64; 2], div_v: f64, pen: Dual<N>) -> Dual<N> {
+    let (gp, gh) = (&q.grad_p, &q.grad_h);
+    // div(rho H v) = v . grad(rho H) + rho H div v, grad(rho H) = rho' H grad P + rho grad H
+    let drho_h = q.drho * q.h;
+    let conv = (drho_h * gp[0] + q.rho * gh[0]) * v[0] + (drho_h * gp[1] + q.rho * gh[1]) * v[1] + q.rho * q.h * div_v;
+    if stab.residual == StrongResidual::Couette {
+        return conv + pen;
+    }
+    // grad eps = eps_P grad P + eps_H grad H, eps_P = eps (rho'/rho - eta'/eta), eps_H = 3 eps / H
+    // (written without dividing by H); FrozenLubricant drops eps_P grad P.
+    let eps_h = q.rho * q.h * q.h * 3.0 / (q.eta * lambda_bar);
+    let eps_p = if stab.residual == StrongResidual::Full { q.eps * (q.drho / q.rho - q.deta / q.eta) } else { Dual::constant(0.0) };
+    let g_eps = [eps_p * gp[0] + eps_h * gh[0], eps_p * gp[1] + eps_h * gh[1]];
+    let div_flux = q.eps * lap_p + g_eps[0] * gp[0] + g_eps[1] * gp[1];
+    conv - div_flux + pen
+}
+
 /// Element residual and exact Jacobian of the Reynolds equation (no source term).
 ///
 /// `verts`: the 3 vertices; `p`, `h`: nodal P and H (order v0, v1, v2, m01, m12, m20);
@@ -226,6 +263,7 @@ pub fn reynolds_element_with_source(
         }
     });
 
+    let crosswind = crosswind_diffusion();
     let mut res = [D12::constant(0.0); 6];
     for q in DUNAVANT6.iter() {
         let l = &q.l;
@@ -262,16 +300,15 @@ pub fn reynolds_element_with_source(
 
         // Galerkin: eps grad P . grad N_i - rho H (v . grad N_i) - f N_i
         let v_dn: [f64; 6] = std::array::from_fn(|i| v[0] * dn[i][0] + v[1] * dn[i][1]);
+        let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
+        // d rho_bar/dP as a dual (built from rho''): needed by the artificial diffusion and SUPG.
+        let drho_d = if stab.id > 0.0 || stab.supg { pq.chain(drho, (fluid.d2rho)(pq.v)) } else { D12::constant(0.0) };
         // Isotropic artificial diffusion eps_id = id h_e |rho' H v| (exact derivative through
-        // the duals: rho' is a dual built from rho'').
-        let crosswind = crosswind_diffusion();
-        let vn0 = (v[0] * v[0] + v[1] * v[1]).sqrt();
+        // the duals).
         let eps_a = if stab.id > 0.0 {
-            let h_e = streamline_length(&tri, v);
-            let drho_d = pq.chain(drho, (fluid.d2rho)(pq.v));
-            let beta = drho_d * hq * vn0;
+            let beta = drho_d * hq * vn;
             let beta_abs = if beta.v < 0.0 { -beta } else { beta };
-            beta_abs * (stab.id * h_e)
+            beta_abs * (stab.id * streamline_length(&tri, v))
         } else {
             D12::constant(0.0)
         };
@@ -279,41 +316,24 @@ pub fn reynolds_element_with_source(
         for i in 0..6 {
             let flux = gp[0] * dn[i][0] + gp[1] * dn[i][1];
             res[i] += (eps_g * flux - rho_h * v_dn[i] - f * n[i]) * wq;
-            if crosswind && stab.id > 0.0 && vn0 > 0.0 {
+            if crosswind && stab.id > 0.0 && vn > 0.0 {
                 // crosswind only: grad P . grad N - (t . grad P)(t . grad N), t = v/|v|
-                let (tx, tz) = (v[0] / vn0, v[1] / vn0);
+                let (tx, tz) = (v[0] / vn, v[1] / vn);
                 let cw = flux - (gp[0] * tx + gp[1] * tz) * (dn[i][0] * tx + dn[i][1] * tz);
                 res[i] += eps_a * cw * wq;
             }
         }
 
         if stab.supg {
-            let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
             if vn == 0.0 {
                 continue; // the SUPG weight v . grad N_i vanishes
             }
-            // eps_P = eps (rho'/rho - eta'/eta), eps_H = 3 eps / H, as duals (needs rho'', eta'')
-            let deta_d = pq.chain(deta, (fluid.d2eta)(pq.v));
-            let drho_d = pq.chain(drho, (fluid.d2rho)(pq.v));
-            let eps_p = eps * (drho_d / rho_d - deta_d / eta_d);
-            let eps_h = rho_d * hq * hq * 3.0 / (eta_d * fluid.lambda_bar); // 3 eps / H, no division by H
-            // StrongResidual::FrozenLubricant drops the lubricant-property gradient eps_P grad P.
-            let eps_p = if stab.residual == StrongResidual::Full { eps_p } else { D12::constant(0.0) };
-            let g_eps = [eps_p * gp[0] + eps_h * gh[0], eps_p * gp[1] + eps_h * gh[1]];
-            let div_flux = eps * lap_p + g_eps[0] * gp[0] + g_eps[1] * gp[1];
-            // div(rho H v) = v . grad(rho H) + rho H div v, grad(rho H) = rho' H grad P + rho grad H
-            let drho_h = drho_d * hq;
-            let conv = (drho_h * gp[0] + rho_d * gh[0]) * v[0]
-                + (drho_h * gp[1] + rho_d * gh[1]) * v[1]
-                + rho_h * div_v;
             let mut pen = D12::constant(0.0);
             for j in 0..6 {
                 pen += pen_nodes[j] * n[j];
             }
-            let r_strong = match stab.residual {
-                StrongResidual::Couette => conv + pen - f,
-                _ => conv - div_flux + pen - f,
-            };
+            let fields = PointFields { h: hq, grad_p: gp, grad_h: gh, rho: rho_d, drho: drho_d, eta: eta_d, deta: pq.chain(deta, (fluid.d2eta)(pq.v)), eps };
+            let r_strong = strong_residual(stab, &fields, fluid.lambda_bar, lap_p, v, div_v, pen) - f;
 
             // tau = delta h_e / (2|v|) xi(Pe), h_e = streamline length
             let tau = supg_tau(stab, vn, streamline_length(&tri, v), eps, drho_d, hq);

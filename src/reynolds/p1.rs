@@ -8,7 +8,7 @@
 //! nodes as P2, but every basis function integrates to area/3 > 0, so every nodal pressure
 //! carries load (a P2 vertex function integrates to zero).
 use super::dual::Dual;
-use super::element::{streamline_length_from_gradients, supg_tau, Fluid, Stabilisation, StrongResidual};
+use super::element::{streamline_length_from_gradients, strong_residual, supg_tau, Fluid, PointFields, Stabilisation};
 use super::quadrature::DUNAVANT6;
 
 type D6 = Dual<6>;
@@ -65,19 +65,13 @@ pub fn reynolds_p1_element_stab(verts: &[[f64; 2]; 3], p: &[f64; 3], h: &[f64; 3
                 continue;
             }
             let drho_d = pq.chain(drho, (fluid.d2rho)(pq.v));
-            let deta_d = pq.chain(deta, (fluid.d2eta)(pq.v));
             let mut gh = [D6::constant(0.0); 2];
             for j in 0..3 {
                 for c in 0..2 {
                     gh[c] += hd[j] * g[j][c];
                 }
             }
-            let eps_h = rho_d * hq * hq * 3.0 / (eta_d * fluid.lambda_bar);
-            let eps_p = if stab.residual == StrongResidual::Full { eps * (drho_d / rho_d - deta_d / eta_d) } else { D6::constant(0.0) };
-            let div_flux = (eps_p * gp[0] + eps_h * gh[0]) * gp[0] + (eps_p * gp[1] + eps_h * gh[1]) * gp[1];
-            let drho_h = drho_d * hq;
             let div_v: f64 = (0..3).map(|k| vel[k][0] * g[k][0] + vel[k][1] * g[k][1]).sum();
-            let conv = (drho_h * gp[0] + rho_d * gh[0]) * v[0] + (drho_h * gp[1] + rho_d * gh[1]) * v[1] + rho_h * div_v;
             let mut pen = D6::constant(0.0);
             if stab.penalty > 0.0 {
                 for j in 0..3 {
@@ -85,10 +79,9 @@ pub fn reynolds_p1_element_stab(verts: &[[f64; 2]; 3], p: &[f64; 3], h: &[f64; 3
                     pen += pd[j].chain(pv, pdv) * (stab.penalty * l[j]);
                 }
             }
-            let r_strong = match stab.residual {
-                StrongResidual::Couette => conv + pen,
-                _ => conv - div_flux + pen,
-            };
+            let fields = PointFields { h: hq, grad_p: gp, grad_h: gh, rho: rho_d, drho: drho_d, eta: eta_d, deta: pq.chain(deta, (fluid.d2eta)(pq.v)), eps };
+            // P is linear: Lap P = 0.
+            let r_strong = strong_residual(stab, &fields, fluid.lambda_bar, D6::constant(0.0), v, div_v, pen);
             let tau = supg_tau(stab, vn, streamline_length_from_gradients(&g, v), eps, drho_d, hq);
             let t_r = tau * r_strong * wq;
             for i in 0..3 {
@@ -105,6 +98,7 @@ pub fn reynolds_p1_element_stab(verts: &[[f64; 2]; 3], p: &[f64; 3], h: &[f64; 3
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::reynolds::element::StrongResidual;
 
     fn laws() -> (impl Fn(f64) -> (f64, f64), impl Fn(f64) -> (f64, f64)) {
         (|p: f64| ((2.0 * p).exp(), 2.0 * (2.0 * p).exp()), |p: f64| ((1.0 + 2.0 * p) / (1.0 + p), 1.0 / ((1.0 + p) * (1.0 + p))))
