@@ -12,6 +12,7 @@ pub mod app;
 pub mod case;
 pub mod ehl;
 pub mod fem;
+pub mod friction;
 pub mod mesh;
 pub mod output;
 pub mod petsc;

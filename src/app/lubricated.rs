@@ -1,99 +1,220 @@
 //! The lubricated scene: the full EHL system (elasticity + Reynolds + load balance) solved
-//! by Newton, then film and pressure results written to the output folder.
+//! by Newton, the friction pass on the converged fields, and the results written to the
+//! output folder. A scene with `[sweep]` solves every operating point of the sweep on the
+//! same mesh and condensed elastic block, each point from the previous converged state
+//! (see [`super::sweep`]).
 use super::{collective, Context};
-use crate::case::Scene;
-use crate::ehl::{driver, layout::Layout, post::FieldsOnFace};
-use crate::mesh;
+use crate::case::{FrictionModel, Scene};
+use crate::ehl::driver::{self, EhlSolution, EhlSolver};
+use crate::ehl::{layout::Layout, post::FieldsOnFace};
+use crate::friction::pass::{friction_pass, stress_at, FrictionResult, FrictionSetup};
+use crate::friction::shear::ShearLaw;
+use crate::mesh::{self, Mesh};
 use crate::solid::dofmap::DofMap;
 use serde_json::json;
+use std::path::Path;
 use std::time::Instant;
+
+/// What one mesh needs, built once per run.
+pub struct Setup {
+    pub mesh: Mesh,
+    pub part: mesh::Partition,
+    pub dofs: DofMap,
+    pub layout: Layout,
+    pub half: bool,
+    pub mesh_s: f64,
+    pub worst_quality: f64,
+}
+
+impl Setup {
+    pub fn new(ctx: &Context, scene: &Scene) -> Result<Setup, String> {
+        let t0 = Instant::now();
+        let half = false;
+        let mesh = super::dry::build_mesh(scene, half)?;
+        let part = mesh::partition(&mesh, ctx.size);
+        let quality = mesh::quality(&mesh);
+        let dofs = DofMap::new(&mesh, &part, ctx.size);
+        let layout = Layout::new(&mesh, &part, &dofs, &mesh.spec.contact, half, ctx.size);
+        let (n_u, n_p) = layout.counts();
+        ctx.log(format!(
+            "mesh: {} P2 tetrahedra, {} nodes, h_c = {} a, {} contact triangles; unknowns: {} elastic + {} pressure + h0 = {}",
+            mesh.tets.len(), mesh.nodes.len(), mesh.contact_size, mesh.contact_tris.len(), n_u, n_p, layout.total()
+        ));
+        Ok(Setup { mesh, part, dofs, layout, half, mesh_s: t0.elapsed().as_secs_f64(), worst_quality: quality.min_dihedral_deg })
+    }
+}
+
+/// The headline numbers of one converged operating point (SI units), for the sweep table.
+#[derive(Debug, Clone, Default)]
+pub struct PointResult {
+    pub hc: f64,
+    pub hm: f64,
+    pub pmax: f64,
+    pub load_error: f64,
+    pub fx: Option<f64>,
+    pub fz: Option<f64>,
+    /// Film along the transverse centre line x = 0: (z / a, h in m) (rank 0).
+    pub profile_x0: Vec<[f64; 2]>,
+}
 
 pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let hertz = scene.hertz();
-    let scales = scene.scales();
     ctx.log(format!("Hertz: a = {:.5e} m, p_H = {:.5e} Pa; lambda_bar = {:.4e}", hertz.a, hertz.ph, driver::lambda_bar(scene)));
-    let t0 = Instant::now();
-    let half = false;
-    let mesh = super::dry::build_mesh(scene, half)?;
-    let part = mesh::partition(&mesh, ctx.size);
-    let quality = mesh::quality(&mesh);
-    let dofs = DofMap::new(&mesh, &part, ctx.size);
-    let layout = Layout::new(&mesh, &part, &dofs, &mesh.spec.contact, half, ctx.size);
-    let mesh_s = t0.elapsed().as_secs_f64();
-    let (n_u, n_p) = layout.counts();
-    ctx.log(format!(
-        "mesh: {} P2 tetrahedra, {} nodes, h_c = {} a, {} contact triangles; unknowns: {} elastic + {} pressure + h0 = {}",
-        mesh.tets.len(), mesh.nodes.len(), mesh.contact_size, mesh.contact_tris.len(), n_u, n_p, layout.total()
-    ));
-    let sol = driver::solve(ctx, scene, &mesh, &part, &dofs, &layout, half)?;
+    let setup = Setup::new(ctx, scene)?;
+    let solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
+    if scene.is_sweep() {
+        return super::sweep::run(ctx, scene, &setup, &solver);
+    }
+    let sol = solver.solve(ctx, scene, None)?;
+    let r = post_point(ctx, scene, &setup, &sol, solver.condensation_s, &ctx.out_dir);
+    collective::agree(&ctx.world, r).map(|_| ())
+}
+
+/// The friction setup of the scene, or None when `effects.friction = "none"`.
+pub fn friction_setup<'a>(scene: &Scene, eta: &'a dyn Fn(f64) -> f64, rect: crate::mesh::Rect) -> Option<FrictionSetup<'a>> {
+    let law = match scene.effects.friction {
+        FrictionModel::Off => return None,
+        FrictionModel::Newtonian => ShearLaw::Newtonian,
+        FrictionModel::ReeEyring => ShearLaw::ReeEyring { tau0: scene.lubricant.as_ref()?.ree_eyring_stress },
+    };
+    let (hertz, scales) = (scene.hertz(), scene.scales());
+    Some(FrictionSetup { law, eta, kinematics: scene.kinematics()?, a: hertz.a, ph: hertz.ph, hs: scales.film_scale(), rect, load: scene.operating.load })
+}
+
+/// Post-processing of one converged point: film statistics and log line on every rank; on
+/// rank 0 the friction pass and every output file in `dir` (profiles, plots, VTU,
+/// summary.json last). Returns the point's numbers (rank 0; the others return the film
+/// numbers without friction). Not collective except for the peak-memory reduction.
+pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution, condensation_s: f64, dir: &Path) -> Result<PointResult, String> {
     let t_post = Instant::now();
-    let fields = FieldsOnFace::new(&mesh, &layout, &sol.x);
+    let (mesh, layout) = (&setup.mesh, &setup.layout);
+    let hertz = scene.hertz();
+    let fields = FieldsOnFace::new(mesh, layout, &sol.x);
     let st = fields.stats();
-    let target = if half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 };
+    let target = if setup.half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 };
     let load_error = (st.load - target).abs() / target;
-    let hs = scales.film_scale();
+    let hs = scene.scales().film_scale();
     let (a, ph) = (hertz.a, hertz.ph);
     ctx.log(format!(
         "result: hc = {:.4e} m, hm = {:.4e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa, load error {:.2e}",
         st.hc * hs, st.hm * hs, st.hm_at[0], st.hm_at[1], st.pmax * ph, load_error
     ));
     let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
-    if ctx.rank == 0 {
-        let r = &mesh.spec.contact;
-        let prof_x0: Vec<Vec<f64>> = fields.profile([0.0, r.z0], [0.0, r.z1], 601).iter().map(|s| vec![s[0] * a, s[1] * a, s[2] * ph, s[3] * hs]).collect();
-        let prof_z0: Vec<Vec<f64>> = fields.profile([r.x0, 0.0], [r.x1, 0.0], 601).iter().map(|s| vec![s[0] * a, s[1] * a, s[2] * ph, s[3] * hs]).collect();
-        write_profiles(ctx, "profile_x0.csv", &prof_x0)?;
-        write_profiles(ctx, "profile_z0.csv", &prof_z0)?;
-        if scene.output.png {
-            write_plots(ctx, &fields, a, ph, hs, &prof_x0, &prof_z0)?;
-        }
-        if scene.output.vtu {
-            write_face_vtu(ctx, &fields, a, ph, hs)?;
-        }
-        let hd = scene.hamrock_dowson();
-        let summary = json!({
-            "case": scene.name,
-            "ranks": ctx.size,
-            "converged": sol.report.converged,
-            "hertz": { "a_m": a, "ph_pa": ph, "e_prime_pa": hertz.e_prime },
-            "mesh": {
-                "elements": mesh.tets.len(), "nodes": mesh.nodes.len(), "dofs_total": layout.total(),
-                "contact_triangles": mesh.contact_tris.len(), "contact_size_a": mesh.contact_size,
-                "worst_quality": quality.min_dihedral_deg, "worst_quality_measure": "minimum dihedral angle (degrees)",
-            },
-            "film": {
-                "hc_m": st.hc * hs, "hm_m": st.hm * hs, "hm_x_m": st.hm_at[0] * a, "hm_z_m": st.hm_at[1] * a, "h0_m": st.h0 * hs,
-                "hc_hamrock_dowson_m": hd.map(|h| h.central_film_thickness()),
-                "hm_hamrock_dowson_m": hd.map(|h| h.minimum_film_thickness()),
-            },
-            "pressure": { "pmax_pa": st.pmax * ph, "pmax_x_m": st.pmax_at[0] * a, "pmax_z_m": st.pmax_at[1] * a, "pmin_pa": st.pmin * ph, "load_error_rel": load_error },
-            "solver": {
-                "newton_iterations": sol.newton_total, "snes_reason": sol.report.reason,
-                "residual_norm": sol.report.residual_norm,
-                "dofs_elastic": n_u, "dofs_reynolds": n_p, "path": sol.steps,
-                "penalty": scene.reynolds.penalty, "stabilisation": scene.reynolds.stabilisation.as_str(),
-            },
-            "timing": { "mesh_s": mesh_s, "assembly_s": sol.assembly_s, "solve_s": sol.solve_s, "post_s": t_post.elapsed().as_secs_f64(), "total_s": ctx.start.elapsed().as_secs_f64() },
-            "peak_rss_mb": peak,
-            "scene": scene,
-        });
-        ctx.write_summary(&summary)?;
+    let mut res = PointResult { hc: st.hc * hs, hm: st.hm * hs, pmax: st.pmax * ph, load_error, fx: None, fz: None, profile_x0: Vec::new() };
+    if ctx.rank != 0 {
+        return Ok(res);
     }
-    Ok(())
+    let visc = scene.viscosity_law().expect("lubricated scene");
+    let eta = move |p: f64| visc.viscosity_and_derivative(p).0;
+    let rect = mesh.spec.contact;
+    let fset = friction_setup(scene, &eta, rect);
+    let friction = match &fset {
+        Some(fs) => {
+            let f = friction_pass(&fields, fs)?;
+            ctx.log(format!("friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s)", scene.effects.friction, f.fx, f.fz, f.fx_n, f.fz_n, f.tau_max, f.seconds));
+            res.fx = Some(f.fx);
+            res.fz = Some(f.fz);
+            Some(f)
+        }
+        None => None,
+    };
+    let tau = |x: f64, z: f64| -> Result<Option<[f64; 2]>, String> {
+        match &fset {
+            Some(fs) => stress_at(&fields, fs, x, z).transpose(),
+            None => Ok(None),
+        }
+    };
+    let r = &mesh.spec.contact;
+    let profile = |from: [f64; 2], to: [f64; 2]| -> Result<Vec<Vec<f64>>, String> {
+        let mut rows = Vec::new();
+        for s in fields.profile(from, to, 601) {
+            let mut row = vec![s[0] * a, s[1] * a, s[2] * ph, s[3] * hs];
+            if let Some(t) = tau(s[0], s[1])? {
+                row.extend(t);
+            }
+            rows.push(row);
+        }
+        Ok(rows)
+    };
+    let prof_x0 = profile([0.0, r.z0], [0.0, r.z1])?;
+    let prof_z0 = profile([r.x0, 0.0], [r.x1, 0.0])?;
+    res.profile_x0 = prof_x0.iter().map(|r| [r[1] / a, r[3]]).collect();
+    let with_tau = friction.is_some();
+    write_profiles(dir, "profile_x0.csv", &prof_x0, with_tau)?;
+    write_profiles(dir, "profile_z0.csv", &prof_z0, with_tau)?;
+    if with_tau {
+        let zl = scene.output.shear_profile_z / a;
+        let line = profile([r.x0, zl], [r.x1, zl])?;
+        write_profiles(dir, "shear_profile.csv", &line, true)?;
+    }
+    if scene.output.png {
+        write_plots(dir, &fields, a, ph, hs, &prof_x0, &prof_z0)?;
+        if let Some(f) = &friction {
+            let zl = scene.output.shear_profile_z / a;
+            super::plots::friction_plots(dir, &fields, f, a, scene.output.shear_profile_z, &profile([r.x0, zl], [r.x1, zl])?)?;
+        }
+        if let Some(k) = scene.kinematics() {
+            super::plots::velocity_plots(dir, &k, a, r)?;
+        }
+    }
+    if scene.output.vtu {
+        write_face_vtu(dir, &fields, a, ph, hs, friction.as_ref())?;
+    }
+    let hd = scene.hamrock_dowson();
+    let (n_u, n_p) = layout.counts();
+    let kin = scene.kinematics().expect("lubricated scene");
+    let mut summary = json!({
+        "case": scene.name,
+        "ranks": ctx.size,
+        "converged": sol.report.converged,
+        "hertz": { "a_m": a, "ph_pa": ph, "e_prime_pa": hertz.e_prime },
+        "operating": { "load_n": scene.operating.load, "entrainment_speed_m_s": scene.operating.entrainment_speed, "slide_to_roll": scene.operating.slide_to_roll, "tilt_angle_deg": scene.operating.tilt_angle },
+        "kinematics": {
+            "model": scene.effects.kinematics.as_str(),
+            "omega_B_rad_s": kin.omega_b, "omega_D_rad_s": kin.omega_d, "U_BO_m_s": kin.u_bo, "U_DO_m_s": kin.u_do,
+        },
+        "mesh": {
+            "elements": mesh.tets.len(), "nodes": mesh.nodes.len(), "dofs_total": layout.total(),
+            "contact_triangles": mesh.contact_tris.len(), "contact_size_a": mesh.contact_size,
+            "worst_quality": setup.worst_quality, "worst_quality_measure": "minimum dihedral angle (degrees)",
+        },
+        "film": {
+            "hc_m": st.hc * hs, "hm_m": st.hm * hs, "hm_x_m": st.hm_at[0] * a, "hm_z_m": st.hm_at[1] * a, "h0_m": st.h0 * hs,
+            "hc_hamrock_dowson_m": hd.map(|h| h.central_film_thickness()),
+            "hm_hamrock_dowson_m": hd.map(|h| h.minimum_film_thickness()),
+        },
+        "pressure": { "pmax_pa": st.pmax * ph, "pmax_x_m": st.pmax_at[0] * a, "pmax_z_m": st.pmax_at[1] * a, "pmin_pa": st.pmin * ph, "load_error_rel": load_error },
+        "solver": {
+            "newton_iterations": sol.newton_total, "snes_reason": sol.report.reason,
+            "residual_norm": sol.report.residual_norm,
+            "dofs_elastic": n_u, "dofs_reynolds": n_p, "path": sol.steps,
+            "penalty": scene.reynolds.penalty, "stabilisation": scene.reynolds.stabilisation.as_str(),
+        },
+        "timing": { "mesh_s": setup.mesh_s, "condensation_s": condensation_s, "assembly_s": sol.assembly_s, "solve_s": sol.solve_s, "post_s": t_post.elapsed().as_secs_f64(), "total_s": ctx.start.elapsed().as_secs_f64() },
+        "peak_rss_mb": peak,
+        "scene": scene,
+    });
+    if let Some(f) = &friction {
+        summary["friction"] = json!({ "model": scene.effects.friction.as_str(), "fx": f.fx, "fz": f.fz, "Fx_n": f.fx_n, "Fz_n": f.fz_n, "tau_max_pa": f.tau_max });
+        summary["timing"]["friction_s"] = json!(f.seconds);
+    }
+    ctx.write_summary_to(dir, &summary)?;
+    Ok(res)
 }
 
-fn write_profiles(ctx: &Context, name: &str, rows: &[Vec<f64>]) -> Result<(), String> {
-    let mut text = String::from("x_m,z_m,p_pa,h_m\n");
+fn write_profiles(dir: &Path, name: &str, rows: &[Vec<f64>], with_tau: bool) -> Result<(), String> {
+    let mut text = String::from(if with_tau { "x_m,z_m,p_pa,h_m,tau_yx_pa,tau_yz_pa\n" } else { "x_m,z_m,p_pa,h_m\n" });
     for r in rows {
-        text.push_str(&format!("{:e},{:e},{:e},{:e}\n", r[0], r[1], r[2], r[3]));
+        text.push_str(&r.iter().map(|v| format!("{v:e}")).collect::<Vec<_>>().join(","));
+        text.push('\n');
     }
-    let path = ctx.out_dir.join(name);
+    let path = dir.join(name);
     crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 /// PNG maps of p and h on the Reynolds rectangle and PNG plots of the two centre-line
 /// profiles (rank 0). Each P2 triangle is drawn as its 4 linear sub-triangles.
-fn write_plots(ctx: &Context, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, prof_x0: &[Vec<f64>], prof_z0: &[Vec<f64>]) -> Result<(), String> {
+fn write_plots(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, prof_x0: &[Vec<f64>], prof_z0: &[Vec<f64>]) -> Result<(), String> {
     let mesh = fields.mesh;
     use crate::output::plot::{line_plot, map_plot, LineOpts, MapOpts, Series, Style};
     let mut tris = Vec::new();
@@ -119,7 +240,7 @@ fn write_plots(ctx: &Context, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, p
         ("pressure_map.png", "pressure", &pv, "p (GPa)", None),
         ("film_map.png", "film thickness (colours saturate at 4 hc)", &hv, "h (um)", Some((0.0, h_top))),
     ] {
-        let path = ctx.out_dir.join(name);
+        let path = dir.join(name);
         crate::output::write_atomic_with(&path, |t| map_plot(t, title, "x / a", "z / a", &tris, vals, &opts(label, range)))?;
     }
     for (name, title, rows, col, xl) in [
@@ -130,15 +251,16 @@ fn write_plots(ctx: &Context, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, p
         let p = Series::new("p (GPa)", x.clone(), rows.iter().map(|r| r[2] * 1e-9).collect(), Style::Line);
         let h = Series::new("h (um)", x, rows.iter().map(|r| r[3] * 1e6).collect(), Style::Line).on_secondary();
         let lo = LineOpts { y2label: "h (um)".into(), y2_range: Some((0.0, h_top)), ..LineOpts::default() };
-        let path = ctx.out_dir.join(name);
+        let path = dir.join(name);
         crate::output::write_atomic_with(&path, |t| line_plot(t, title, xl, "p (GPa)", &[p, h], &lo))?;
     }
     Ok(())
 }
 
-/// VTU of the contact face (P2 triangles, coordinates in m): p, h and the normal
-/// displacement u2, for ParaView.
-fn write_face_vtu(ctx: &Context, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64) -> Result<(), String> {
+/// VTU of the contact face (P2 triangles, coordinates in m): p, h, the normal
+/// displacement u2 and, with friction, the disc shear stress (averaged over the
+/// triangles sharing a node), for ParaView.
+fn write_face_vtu(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, friction: Option<&FrictionResult>) -> Result<(), String> {
     let mesh = fields.mesh;
     let mut id = vec![u32::MAX; mesh.nodes.len()];
     let mut points = Vec::new();
@@ -151,11 +273,30 @@ fn write_face_vtu(ctx: &Context, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64
         h.push(fields.h_node(n) * hs);
         u2.push(fields.layout.uy(fields.x, n) * hs);
     }
+    let mut tau = vec![0.0; 3 * points.len()];
+    if let Some(f) = friction {
+        let mut count = vec![0.0; points.len()];
+        for (t, vals) in &f.nodal {
+            for (k, &n) in mesh.contact_tris[*t].iter().enumerate() {
+                let i = id[n as usize] as usize;
+                tau[3 * i] += vals[k][0];
+                tau[3 * i + 2] += vals[k][1];
+                count[i] += 1.0;
+            }
+        }
+        for (i, c) in count.iter().enumerate() {
+            if *c > 0.0 {
+                tau[3 * i] /= c;
+                tau[3 * i + 2] /= c;
+            }
+        }
+    }
     let conn: Vec<u32> = mesh.contact_tris.iter().flat_map(|t| t.map(|n| id[n as usize])).collect();
     use crate::output::vtu::{write_vtu_single_type, Field};
-    let path = ctx.out_dir.join("contact_face.vtu");
-    crate::output::write_atomic_with(&path, |t| {
-        write_vtu_single_type(t, &points, 22, &conn, &[Field { name: "p_pa", components: 1, values: &p }, Field { name: "h_m", components: 1, values: &h }, Field { name: "u2_m", components: 1, values: &u2 }], &[])
-            .map_err(|e| format!("cannot write {}: {e}", t.display()))
-    })
+    let mut vtu_fields = vec![Field { name: "p_pa", components: 1, values: &p }, Field { name: "h_m", components: 1, values: &h }, Field { name: "u2_m", components: 1, values: &u2 }];
+    if friction.is_some() {
+        vtu_fields.push(Field { name: "tau_disc_pa", components: 3, values: &tau });
+    }
+    let path = dir.join("contact_face.vtu");
+    crate::output::write_atomic_with(&path, |t| write_vtu_single_type(t, &points, 22, &conn, &vtu_fields, &[]).map_err(|e| format!("cannot write {}: {e}", t.display())))
 }

@@ -3,6 +3,8 @@
 pub mod collective;
 pub mod dry;
 pub mod lubricated;
+pub mod plots;
+pub mod sweep;
 
 use crate::case::Scene;
 use crate::petsc::Petsc;
@@ -44,7 +46,12 @@ impl Context {
     /// Writes summary.json into the output folder (rank 0 calls it, once, after success;
     /// atomically, so a failed run leaves no summary behind).
     pub fn write_summary(&self, summary: &serde_json::Value) -> Result<(), String> {
-        let path = self.out_dir.join("summary.json");
+        self.write_summary_to(&self.out_dir.clone(), summary)
+    }
+
+    /// Writes summary.json into `dir` (atomically; see [`Context::write_summary`]).
+    pub fn write_summary_to(&self, dir: &std::path::Path, summary: &serde_json::Value) -> Result<(), String> {
+        let path = dir.join("summary.json");
         let text = serde_json::to_string_pretty(summary).map_err(|e| e.to_string())?;
         crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         self.log(format!("wrote {}", path.display()));

@@ -182,6 +182,62 @@ impl Scene {
                 return Err(missing("operating.entrainment_speed"));
             }
         }
+        if let Some(sw) = &self.sweep {
+            if e.lubrication != LubricationModel::Reynolds {
+                return Err(SceneErrorKind::Conflict(
+                    "[sweep] is given but effects.lubrication = \"none\": a sweep varies the lubricated operating point (remove [sweep] or set effects.lubrication = \"reynolds\")".into(),
+                )
+                .into());
+            }
+            if sw.tilt_angle.is_some() && e.kinematics == KinematicsModel::Uniform {
+                return Err(SceneErrorKind::Conflict(
+                    "sweep.tilt_angle is given but effects.kinematics = \"uniform\" ignores the tilt angle (remove sweep.tilt_angle or set effects.kinematics = \"spin\")".into(),
+                )
+                .into());
+            }
+        }
+        for point in self.points() {
+            point.validate_kinematics()?;
+        }
+        Ok(())
+    }
+
+    /// The operating points of the scene: the scene itself, or one scene per combination
+    /// of the `[sweep]` lists (entrainment speed outermost, slide-to-roll innermost), each
+    /// without `[sweep]` and with the `[operating]` values replaced.
+    pub fn points(&self) -> Vec<Scene> {
+        let Some(sw) = &self.sweep else {
+            return vec![self.clone()];
+        };
+        let op = &self.operating;
+        let ues: Vec<Option<f64>> = match &sw.entrainment_speed {
+            Some(v) => v.iter().map(|&u| Some(u)).collect(),
+            None => vec![op.entrainment_speed],
+        };
+        let lambdas = sw.tilt_angle.clone().unwrap_or_else(|| vec![op.tilt_angle]);
+        let srrs = sw.slide_to_roll.clone().unwrap_or_else(|| vec![op.slide_to_roll]);
+        let mut out = Vec::new();
+        for &ue in &ues {
+            for &lambda in &lambdas {
+                for &srr in &srrs {
+                    let mut s = self.clone();
+                    s.sweep = None;
+                    s.operating.entrainment_speed = ue;
+                    s.operating.tilt_angle = lambda;
+                    s.operating.slide_to_roll = srr;
+                    out.push(s);
+                }
+            }
+        }
+        out
+    }
+
+    /// Whether the scene sweeps its operating point (`[sweep]` given).
+    pub fn is_sweep(&self) -> bool {
+        self.sweep.is_some()
+    }
+
+    fn validate_kinematics(&self) -> Result<(), SceneError> {
         if let Some(ue) = self.operating.entrainment_speed {
             // Kinematics must be constructible (guards against programmatic scenes).
             Kinematics::new(

@@ -92,6 +92,10 @@ pub struct Scene {
     /// Output directory and formats.
     #[serde(default)]
     pub output: OutputSettings,
+    /// Optional parameter sweep: lists that replace `[operating]` values, one solve per
+    /// combination.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<Sweep>,
 }
 
 /// Keys of the top level of the scene file.
@@ -158,6 +162,13 @@ pub const SCENE_FIELDS: &[Field] = &[
         "",
         Kind::Table(OUTPUT_FIELDS),
         Presence::Default("the values below")
+    ),
+    f!(
+        "sweep",
+        "parameter sweep: lists of operating values, one converged solve per combination (entrainment speed outermost, slide-to-roll innermost), each started from the previous converged state",
+        "",
+        Kind::Table(SWEEP_FIELDS),
+        Presence::Default("none (one operating point)")
     ),
 ];
 
@@ -358,6 +369,33 @@ pub const OPERATING_FIELDS: &[Field] = &[
     f!("tilt_angle", "tilt angle lambda of the ball's rotation axis", "degrees", Kind::Number(Range::LeftOpen(0.0, 90.0)),
         Presence::Default("90"),
         note = "lambda = 0 is singular: the ball spin omega_B = U_BO/(R_B sin lambda) would be infinite"),
+];
+
+// ---------------------------------------------------------------------------------------
+// [sweep]
+
+/// `[sweep]`: lists of operating values (each replaces the `[operating]` value). The
+/// points are the Cartesian product, entrainment speed outermost and slide-to-roll
+/// innermost, each list in the order given.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Sweep {
+    /// Entrainment speeds Ue (m/s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub entrainment_speed: Option<Vec<f64>>,
+    /// Tilt angles lambda (degrees).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tilt_angle: Option<Vec<f64>>,
+    /// Slide-to-roll ratios SRR (fractions).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slide_to_roll: Option<Vec<f64>>,
+}
+
+/// Keys of `[sweep]`.
+pub const SWEEP_FIELDS: &[Field] = &[
+    f!("entrainment_speed", "entrainment speeds Ue", "m/s", Kind::NumberList(Range::Positive), Presence::Default("operating.entrainment_speed")),
+    f!("tilt_angle", "tilt angles lambda", "degrees", Kind::NumberList(Range::LeftOpen(0.0, 90.0)), Presence::Default("operating.tilt_angle")),
+    f!("slide_to_roll", "slide-to-roll ratios SRR (fractions)", "", Kind::NumberList(Range::AbsAtMost(2.0)), Presence::Default("operating.slide_to_roll")),
 ];
 
 // ---------------------------------------------------------------------------------------
@@ -714,6 +752,9 @@ pub struct OutputSettings {
     pub vtu: bool,
     /// Write PNG plots; default true.
     pub png: bool,
+    /// z (m) of the rolling-direction line along which the friction pass writes its
+    /// shear-stress profile (`shear_profile.csv`); default 0 (the centre line).
+    pub shear_profile_z: f64,
 }
 
 impl Default for OutputSettings {
@@ -723,6 +764,7 @@ impl Default for OutputSettings {
             dir: String::new(),
             vtu: true,
             png: true,
+            shear_profile_z: 0.0,
         }
     }
 }
@@ -749,5 +791,12 @@ pub const OUTPUT_FIELDS: &[Field] = &[
         "",
         Kind::Bool,
         Presence::Default("true")
+    ),
+    f!(
+        "shear_profile_z",
+        "z of the rolling-direction line of the shear-stress profile (shear_profile.csv)",
+        "m",
+        Kind::Number(Range::Any),
+        Presence::Default("0")
     ),
 ];

@@ -69,6 +69,8 @@ impl Range {
 pub enum Kind {
     /// A finite number (integer or float) in the range.
     Number(Range),
+    /// A non-empty array of finite numbers, each in the range (a sweep).
+    NumberList(Range),
     /// true or false.
     Bool,
     /// A non-empty string.
@@ -114,6 +116,8 @@ impl Field {
         match self.kind {
             Kind::Number(r) if self.unit.is_empty() => format!("{}, {}", self.what, r.describe()),
             Kind::Number(r) => format!("{} in {}, {}", self.what, self.unit, r.describe()),
+            Kind::NumberList(r) if self.unit.is_empty() => format!("{}, each {}", self.what, r.describe()),
+            Kind::NumberList(r) => format!("{} in {}, each {}", self.what, self.unit, r.describe()),
             Kind::Bool => format!("{}, true or false", self.what),
             Kind::Text => self.what.to_string(),
             Kind::Choice(c) => format!("{}: one of {}", self.what, quoted_list(c)),
@@ -132,6 +136,7 @@ impl Field {
     fn expected(&self) -> String {
         let t = match self.kind {
             Kind::Number(_) => "a number",
+            Kind::NumberList(_) => "a non-empty array of numbers",
             Kind::Bool => "a boolean",
             Kind::Text | Kind::Choice(_) => "a string",
             Kind::Table(_) => "a table",
@@ -289,32 +294,18 @@ fn check_value(
         allowed,
     };
     match field.kind {
-        Kind::Number(range) => {
-            let (v, shown) = match value {
-                Value::Integer(i) => (*i as f64, i.to_string()),
-                Value::Float(x) => (*x, fmt_num(*x)),
-                _ => return Err(wrong()),
-            };
-            if !v.is_finite() {
-                return Err(not_allowed(shown, "must be a finite number".into()));
+        Kind::Number(range) => check_number(field, range, value, path)?,
+        Kind::NumberList(range) => match value {
+            Value::Array(items) if items.is_empty() => {
+                return Err(not_allowed("[]".into(), "must be a non-empty array of numbers".into()))
             }
-            if !range.contains(v) {
-                let unit = if field.unit.is_empty() {
-                    String::new()
-                } else {
-                    format!(" ({})", field.unit)
-                };
-                let note = if field.note.is_empty() {
-                    String::new()
-                } else {
-                    format!("; {}", field.note)
-                };
-                return Err(not_allowed(
-                    shown,
-                    format!("must be {}{unit}{note}", range.describe()),
-                ));
+            Value::Array(items) => {
+                for (i, item) in items.iter().enumerate() {
+                    check_number(field, range, item, &format!("{path}[{i}]"))?;
+                }
             }
-        }
+            _ => return Err(wrong()),
+        },
         Kind::Bool => {
             if !value.is_bool() {
                 return Err(wrong());
@@ -351,6 +342,31 @@ fn check_value(
     Ok(())
 }
 
+/// One number of `field` (also an element of a list, whose `path` carries the index).
+fn check_number(field: &Field, range: Range, value: &Value, path: &str) -> Result<(), SceneErrorKind> {
+    let (v, shown) = match value {
+        Value::Integer(i) => (*i as f64, i.to_string()),
+        Value::Float(x) => (*x, fmt_num(*x)),
+        _ => {
+            return Err(SceneErrorKind::WrongType {
+                path: path.to_string(),
+                expected: field.expected(),
+                found: describe_value(value),
+            })
+        }
+    };
+    let not_allowed = |allowed: String| SceneErrorKind::NotAllowed { path: path.to_string(), value: shown.clone(), allowed };
+    if !v.is_finite() {
+        return Err(not_allowed("must be a finite number".into()));
+    }
+    if !range.contains(v) {
+        let unit = if field.unit.is_empty() { String::new() } else { format!(" ({})", field.unit) };
+        let note = if field.note.is_empty() { String::new() } else { format!("; {}", field.note) };
+        return Err(not_allowed(format!("must be {}{unit}{note}", range.describe())));
+    }
+    Ok(())
+}
+
 /// A Markdown reference of the schema (one heading and table per section), for the README.
 pub fn reference_markdown(root: &'static [Field]) -> String {
     let mut out = String::new();
@@ -380,6 +396,7 @@ fn write_section(
         for f in leaves {
             let allowed = match f.kind {
                 Kind::Number(r) => r.describe(),
+                Kind::NumberList(r) => format!("array, each {}", r.describe()),
                 Kind::Bool => "true, false".into(),
                 Kind::Text => "non-empty string".into(),
                 Kind::Choice(c) => quoted_list(c),

@@ -58,8 +58,14 @@ growth = 0.5
 
 [output]
 dir = "out/paper-spin-2deg"
+shear_profile_z = -0.12e-3
 vtu = true
 png = false
+
+[sweep]
+entrainment_speed = [2.0, 3.0]
+tilt_angle = [90, 7, 2]
+slide_to_roll = [0.0, 0.05]
 "#;
 
 /// Example 2: dry Hertz contact, minimal (no lubricant, no name, defaults elsewhere).
@@ -251,7 +257,8 @@ fn physics_helpers() {
     // Uniform kinematics and derived z_R.
     let u = parse_scene(
         &paper_with("kinematics = \"spin\"", "kinematics = \"uniform\"")
-            .replace("roelands_exponent = 0.8591\n", ""),
+            .replace("roelands_exponent = 0.8591\n", "")
+            .replace("tilt_angle = [90, 7, 2]\n", ""),
         "x",
     )
     .unwrap();
@@ -366,7 +373,7 @@ fn unknown_key_with_suggestion() {
     let e = err(&paper_with("png = false", "png = false\ncolour = true"));
     assert_eq!(
         e,
-        "unknown key 'output.colour' (known keys here: dir, vtu, png)"
+        "unknown key 'output.colour' (known keys here: dir, vtu, png, shear_profile_z)"
     );
 }
 
@@ -591,4 +598,38 @@ fn programmatic_scene_is_validated() {
         .unwrap_err()
         .to_string()
         .contains("must be a finite number"));
+}
+
+#[test]
+fn sweep_points_are_the_product_in_order() {
+    let s = parse_scene(PAPER_SPIN, "x").unwrap();
+    let pts = s.points();
+    assert_eq!(pts.len(), 2 * 3 * 2);
+    // Slide-to-roll innermost, entrainment speed outermost.
+    let key = |p: &Scene| (p.operating.entrainment_speed.unwrap(), p.operating.tilt_angle, p.operating.slide_to_roll);
+    assert_eq!(key(&pts[0]), (2.0, 90.0, 0.0));
+    assert_eq!(key(&pts[1]), (2.0, 90.0, 0.05));
+    assert_eq!(key(&pts[2]), (2.0, 7.0, 0.0));
+    assert_eq!(key(&pts[11]), (3.0, 2.0, 0.05));
+    assert!(pts.iter().all(|p| p.sweep.is_none()));
+    // Without [sweep]: the scene itself.
+    let mut one = s.clone();
+    one.sweep = None;
+    assert_eq!(one.points(), vec![one.clone()]);
+}
+
+#[test]
+fn bad_sweep_lists_name_the_element() {
+    let bad = PAPER_SPIN.replace("tilt_angle = [90, 7, 2]", "tilt_angle = [90, 0, 2]");
+    let e = parse_scene(&bad, "x").unwrap_err().to_string();
+    assert!(e.contains("sweep.tilt_angle[1]") && e.contains("(0, 90]"), "{e}");
+    let empty = PAPER_SPIN.replace("tilt_angle = [90, 7, 2]", "tilt_angle = []");
+    let e = parse_scene(&empty, "x").unwrap_err().to_string();
+    assert!(e.contains("sweep.tilt_angle") && e.contains("non-empty"), "{e}");
+    let text = PAPER_SPIN.replace("tilt_angle = [90, 7, 2]", "tilt_angle = \"2\"");
+    let e = parse_scene(&text, "x").unwrap_err().to_string();
+    assert!(e.contains("sweep.tilt_angle") && e.contains("array"), "{e}");
+    let uniform = PAPER_SPIN.replace("kinematics = \"spin\"", "kinematics = \"uniform\"");
+    let e = parse_scene(&uniform, "x").unwrap_err().to_string();
+    assert!(e.contains("sweep.tilt_angle") && e.contains("uniform"), "{e}");
 }

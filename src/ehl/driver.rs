@@ -135,55 +135,114 @@ fn start_h0(scene: &Scene, mesh: &Mesh, uy: &dyn Fn(u32) -> f64) -> Result<f64, 
     Ok((hc + uy_centre).max(0.5 * hc - min_gap))
 }
 
-/// Builds and solves the EHL system of the scene on the given mesh. The elastic block is
-/// condensed onto the contact face unless `EHL_MONOLITHIC` is set (developer switch).
-#[allow(clippy::too_many_arguments)]
-pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
-    set_newton_defaults().map_err(|e| e.to_string())?;
-    if std::env::var_os("EHL_MONOLITHIC").is_some() {
+/// The lubricated solver of one mesh: the parts that do not depend on the operating
+/// point (the elastic block condensed onto the contact face) are built once by
+/// [`EhlSolver::new`]; [`EhlSolver::solve`] then solves any operating point of the same
+/// geometry and materials (a sweep), optionally from a previous converged state.
+pub struct EhlSolver<'a> {
+    mesh: &'a Mesh,
+    part: &'a Partition,
+    dofs: &'a DofMap,
+    layout: &'a Layout,
+    half: bool,
+    /// Face compliance (condensed path); None on the monolithic developer path.
+    comp: Option<crate::solid::condense::Compliance>,
+    /// Seconds spent building the compliance.
+    pub condensation_s: f64,
+}
+
+impl<'a> EhlSolver<'a> {
+    /// Condenses the elastic block onto the contact face (unless `EHL_MONOLITHIC` is set).
+    /// Collective.
+    pub fn new(ctx: &Context, scene: &Scene, mesh: &'a Mesh, part: &'a Partition, dofs: &'a DofMap, layout: &'a Layout, half: bool) -> Result<Self, String> {
+        set_newton_defaults().map_err(|e| e.to_string())?;
+        let monolithic = std::env::var_os("EHL_MONOLITHIC").is_some();
+        if !monolithic {
+            // The condensed Jacobian is dense: MUMPS's PORD ordering rejects it, AMD is fine.
+            petsc::options::set_default("-mat_mumps_icntl_7", "0").map_err(|e| e.to_string())?;
+        }
         petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
-        solve_monolithic(ctx, scene, mesh, part, dofs, layout, half)
-    } else {
-        // The condensed Jacobian is dense: MUMPS's PORD ordering rejects it, AMD is fine.
-        petsc::options::set_default("-mat_mumps_icntl_7", "0").map_err(|e| e.to_string())?;
-        petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
-        solve_condensed(ctx, scene, mesh, layout, half)
+        let t0 = std::time::Instant::now();
+        let comp = if monolithic {
+            None
+        } else {
+            let eq = scene.equivalent_solid();
+            let p_nodes: Vec<u32> = mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect();
+            let comp = crate::solid::condense::face_compliance(&ctx.world, mesh, eq.nu, assembly::traction_factor(eq.nu), &p_nodes).map_err(|e| e.to_string())?;
+            ctx.log(format!(
+                "elastic block condensed onto the contact face: {} elastic unknowns -> {} face nodes x {} pressure nodes ({:.2} s)",
+                comp.elastic_unknowns,
+                comp.rows.len(),
+                comp.cols.len(),
+                comp.seconds
+            ));
+            Some(comp)
+        };
+        Ok(EhlSolver { mesh, part, dofs, layout, half, comp, condensation_s: t0.elapsed().as_secs_f64() })
+    }
+
+    /// Solves the scene's operating point. `start`: a converged state of a neighbouring
+    /// operating point (monolithic layout, as in [`EhlSolution::x`]); when Newton fails
+    /// from it, the solve starts over from the Hertz start. Collective.
+    pub fn solve(&self, ctx: &Context, scene: &Scene, start: Option<&[f64]>) -> Result<EhlSolution, String> {
+        match &self.comp {
+            None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half),
+            Some(comp) => {
+                if let Some(prev) = start {
+                    match solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, Some(prev)) {
+                        Ok(s) => return Ok(s),
+                        Err(e) => ctx.log(format!("Newton from the previous operating point failed ({e}); starting over from the Hertz start")),
+                    }
+                }
+                solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, None)
+            }
+        }
     }
 }
 
-/// The condensed path: face compliance once, then Newton on (P, H0).
-fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
+/// Builds and solves the EHL system of the scene on the given mesh (one operating point).
+#[allow(clippy::too_many_arguments)]
+pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
+    EhlSolver::new(ctx, scene, mesh, part, dofs, layout, half)?.solve(ctx, scene, None)
+}
+
+/// The condensed path: Newton on (P, H0) with the face compliance `comp`, from the Hertz
+/// start or from a previous state `start` (monolithic layout).
+fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, comp: &crate::solid::condense::Compliance, half: bool, start: Option<&[f64]>) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
-    let p_nodes: Vec<u32> = mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect();
-    let comp = crate::solid::condense::face_compliance(&ctx.world, mesh, eq.nu, assembly::traction_factor(eq.nu), &p_nodes).map_err(pe)?;
-    ctx.log(format!(
-        "elastic block condensed onto the contact face: {} elastic unknowns -> {} face nodes x {} pressure nodes ({:.2} s)",
-        comp.elastic_unknowns,
-        comp.rows.len(),
-        comp.cols.len(),
-        comp.seconds
-    ));
-    let mut system = CondensedSystem::new(mesh, &comp, ctx.size, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene));
+    let mut system = CondensedSystem::new(mesh, comp, ctx.size, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene));
     let cl = system.layout.clone();
     system.debug_mesh = Some(mesh);
-    // Start: Hertz pressure and its (condensed) deflection.
     let mut x0 = vec![0.0; cl.total()];
-    for (j, &n) in comp.cols.iter().enumerate() {
-        let c = mesh.nodes[n as usize];
-        x0[j] = hertz_load::hertz_pressure(c[0], c[2]);
-    }
-    let uy0 = system.uy(&x0);
-    x0[cl.h0()] = start_h0(scene, mesh, &|n| uy0[cl.face_index[n as usize] as usize])?;
+    let label = match start {
+        Some(prev) => {
+            for (j, &n) in comp.cols.iter().enumerate() {
+                x0[j] = prev[layout.p[n as usize] as usize];
+            }
+            x0[cl.h0()] = prev[layout.h0 as usize];
+            "the previous operating point"
+        }
+        None => {
+            // Hertz pressure and its (condensed) deflection.
+            for (j, &n) in comp.cols.iter().enumerate() {
+                let c = mesh.nodes[n as usize];
+                x0[j] = hertz_load::hertz_pressure(c[0], c[2]);
+            }
+            let uy0 = system.uy(&x0);
+            x0[cl.h0()] = start_h0(scene, mesh, &|n| uy0[cl.face_index[n as usize] as usize])?;
+            "the Hertz start"
+        }
+    };
     let (d_nnz, o_nnz) = system.preallocation();
     let j = Matrix::new_aij(comm, cl.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?;
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
     let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);
-    ctx.log(format!("Newton from the Hertz start: {} unknowns ({} P, 1 H0), dense Jacobian", cl.total(), cl.n_p));
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, &j, (lo, hi), cl.local(ctx.rank))?;
+    ctx.log(format!("Newton from {label}: {} unknowns ({} P, 1 H0), dense Jacobian", cl.total(), cl.n_p));
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.is_none(), &j, (lo, hi), cl.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
     let uy = system.uy(&out.x);
@@ -246,7 +305,7 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
         }
     }
     let (lo, hi) = (layout.ranges[ctx.rank], layout.ranges[ctx.rank + 1]);
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, &j, (lo, hi), layout.local(ctx.rank))?;
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, "the Hertz start", true, &j, (lo, hi), layout.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     Ok(EhlSolution { x: out.x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s })
 }
@@ -259,10 +318,11 @@ struct NewtonOutcome {
     steps: Vec<String>,
 }
 
-/// Newton from `x0` at the scene's operating point; if that fails, a continuation in load
-/// from a light load up to the scene's. Returns the converged iterate (gathered) or an
-/// error naming the path taken.
-fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], j: &Matrix, (lo, hi): (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
+/// Newton from `x0` (described by `label`) at the scene's operating point; if that fails
+/// and `continuation` is set, a continuation in load from a light load up to the scene's.
+/// Returns the converged iterate (gathered) or an error naming the path taken.
+#[allow(clippy::too_many_arguments)]
+fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], label: &str, continuation: bool, j: &Matrix, (lo, hi): (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let x = Vector::new(comm, local).map_err(pe)?;
@@ -285,7 +345,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     } else {
         solve_at(target, system, x0)?
     };
-    let mut steps = vec![format!("Newton from the Hertz start at L = {} N: {} ({} iterations)", target, report.reason, report.iterations)];
+    let mut steps = vec![format!("Newton from {label} at L = {} N: {} ({} iterations)", target, report.reason, report.iterations)];
     ctx.log(&steps[0]);
     let mut newton_total = report.iterations;
     let mut last = report;
@@ -354,7 +414,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     }
     // 3. If it failed: continuation in load. A lighter load is a milder problem in Hertz
     //    units (smaller M, alpha p_H); each converged state starts the next, heavier one.
-    if !last.converged {
+    if !last.converged && continuation {
         let mut load = target / 8.0;
         let mut state: Option<Vec<f64>> = None;
         while load >= target / 64.0 {

@@ -40,6 +40,11 @@ impl<'a> FieldsOnFace<'a> {
         self.layout.film(self.mesh, self.x, n)
     }
 
+    /// The contact triangle containing (x, z) and the point's barycentric coordinates.
+    pub fn locate(&self, x: f64, z: f64) -> Option<(usize, [f64; 3])> {
+        self.locator.locate(self.mesh, x, z)
+    }
+
     /// (P, H) at a point of the contact face, by P2 interpolation.
     pub fn at(&self, x: f64, z: f64) -> Option<(f64, f64)> {
         let (t, b) = self.locator.locate(self.mesh, x, z)?;

@@ -37,6 +37,17 @@ pub fn mpirun(ranks: usize, args: &[&str]) -> Output {
     cmd.output().expect("mpirun could not be started (is openmpi-bin installed? run ci/setup)")
 }
 
+/// Runs `mpirun -n ranks ehl-petsc args...` with extra environment variables.
+pub fn mpirun_env(ranks: usize, args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut cmd = Command::new("mpirun");
+    cmd.arg("-n").arg(ranks.to_string()).arg(binary()).args(args);
+    mpi_env(&mut cmd);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("mpirun could not be started (is openmpi-bin installed? run ci/setup)")
+}
+
 /// Runs the binary directly (MPI singleton), for command-line checks.
 pub fn run_plain(args: &[&str]) -> Output {
     let mut cmd = Command::new(binary());

@@ -1,0 +1,131 @@
+//! The friction pass (physics.md section 7): on the converged pressure and film, the shear
+//! stress on the disc surface at every point of the Reynolds rectangle Omega_c, from the
+//! per-point law of [`super::shear`], and its integrals, the traction forces on the disc
+//! Fx, Fz and the friction coefficients fx = Fx/L, fz = Fz/L.
+//!
+//! The pressure is P2 on each contact triangle; its gradient is taken inside the element
+//! (discontinuous across edges, as the shear stress of the paper's P2 solution is). The
+//! integrals use the degree-6 Dunavant rule on every triangle of Omega_c (the cavitated
+//! zone included: the model has no film-fraction, so the full film is sheared there; its
+//! share is small because the viscosity is low and the film thick).
+use super::shear::{disc_shear_stress, FilmPoint, ShearLaw};
+use crate::ehl::post::FieldsOnFace;
+use crate::fem::geometry::AffineTri;
+use crate::fem::p2tri::{p2_tri_basis_bary, p2_tri_grads_bary};
+use crate::mesh::spec::Rect;
+use crate::physics::Kinematics;
+
+/// What the pass needs besides the fields: the shear law, the viscosity law, the surface
+/// velocities and the scales that turn the dimensionless fields into SI units.
+pub struct FrictionSetup<'a> {
+    pub law: ShearLaw,
+    /// eta(p) in Pa.s for p in Pa.
+    pub eta: &'a dyn Fn(f64) -> f64,
+    pub kinematics: Kinematics,
+    /// Hertz radius a (m), Hertz pressure p_H (Pa), film scale a^2/R (m).
+    pub a: f64,
+    pub ph: f64,
+    pub hs: f64,
+    /// The Reynolds rectangle Omega_c (units of a).
+    pub rect: Rect,
+    /// Normal load L (N) for the friction coefficients.
+    pub load: f64,
+}
+
+/// Result of the friction pass.
+#[derive(Debug, Clone)]
+pub struct FrictionResult {
+    /// Traction forces on the disc (N).
+    pub fx_n: f64,
+    pub fz_n: f64,
+    /// Friction coefficients Fx/L, Fz/L.
+    pub fx: f64,
+    pub fz: f64,
+    /// Shear stress on the disc (tau_yx, tau_yz at y = 0, Pa) at the 6 P2 nodes of every
+    /// contact triangle inside Omega_c: (triangle index, values).
+    pub nodal: Vec<(usize, [[f64; 2]; 6])>,
+    /// Largest |tau| on the disc at the nodes (Pa).
+    pub tau_max: f64,
+    /// Wall time (s).
+    pub seconds: f64,
+}
+
+/// Whether contact triangle `t` lies in Omega_c (its centroid does).
+fn in_rect(fields: &FieldsOnFace, t: usize, r: &Rect) -> bool {
+    let tri = fields.mesh.contact_tris[t];
+    let (mut x, mut z) = (0.0, 0.0);
+    for &n in &tri[..3] {
+        let c = fields.mesh.nodes[n as usize];
+        x += c[0] / 3.0;
+        z += c[2] / 3.0;
+    }
+    x > r.x0 && x < r.x1 && z > r.z0 && z < r.z1
+}
+
+/// The shear stress on the disc at barycentric point `b` of contact triangle `t` (Pa).
+fn stress_in_triangle(fields: &FieldsOnFace, s: &FrictionSetup, t: usize, b: [f64; 3]) -> Result<[f64; 2], String> {
+    let mesh = fields.mesh;
+    let tri = mesh.contact_tris[t];
+    let v: [[f64; 2]; 3] = std::array::from_fn(|i| {
+        let c = mesh.nodes[tri[i] as usize];
+        [c[0], c[2]]
+    });
+    let geo = AffineTri::new(&v);
+    let p = tri.map(|n| fields.p_node(n));
+    let h = tri.map(|n| fields.h_node(n));
+    let phi = p2_tri_basis_bary(b);
+    let dphi = p2_tri_grads_bary(b, &geo.grad_bary);
+    let (mut pv, mut hv, mut g) = (0.0, 0.0, [0.0; 2]);
+    for k in 0..6 {
+        pv += phi[k] * p[k];
+        hv += phi[k] * h[k];
+        g[0] += dphi[k][0] * p[k];
+        g[1] += dphi[k][1] * p[k];
+    }
+    let (x, z) = ((0..3).map(|i| b[i] * v[i][0]).sum::<f64>(), (0..3).map(|i| b[i] * v[i][1]).sum::<f64>());
+    let (xm, zm) = (x * s.a, z * s.a);
+    let vel = s.kinematics.at(xm, zm);
+    // The film's pressure is non-negative; the P2 interpolant's small undershoot at the
+    // cavitation boundary is not a physical tension: the viscosity sees max(p, 0).
+    let pa = pv.max(0.0) * s.ph;
+    let pt = FilmPoint { eta: (s.eta)(pa), h: hv * s.hs, grad_p: [g[0] * s.ph / s.a, g[1] * s.ph / s.a], slide: [vel.du(), vel.dw()] };
+    disc_shear_stress(&s.law, &pt).map_err(|e| format!("friction pass at (x, z) = ({x:.4}a, {z:.4}a): {e}"))
+}
+
+/// Runs the pass over Omega_c (serial; call it on one rank).
+pub fn friction_pass(fields: &FieldsOnFace, s: &FrictionSetup) -> Result<FrictionResult, String> {
+    let t0 = std::time::Instant::now();
+    let mesh = fields.mesh;
+    let (mut fx_n, mut fz_n, mut tau_max) = (0.0, 0.0, 0.0f64);
+    let mut nodal = Vec::new();
+    const NODES: [[f64; 3]; 6] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]];
+    for t in 0..mesh.contact_tris.len() {
+        if !in_rect(fields, t, &s.rect) {
+            continue;
+        }
+        let tri = mesh.contact_tris[t];
+        let v: [[f64; 2]; 3] = std::array::from_fn(|i| {
+            let c = mesh.nodes[tri[i] as usize];
+            [c[0], c[2]]
+        });
+        let area = crate::ehl::system::tri_area(&v) * s.a * s.a;
+        for q in crate::reynolds::quadrature::DUNAVANT6.iter() {
+            let tau = stress_in_triangle(fields, s, t, q.l)?;
+            fx_n += q.w * area * tau[0];
+            fz_n += q.w * area * tau[1];
+        }
+        let mut vals = [[0.0; 2]; 6];
+        for (k, b) in NODES.iter().enumerate() {
+            vals[k] = stress_in_triangle(fields, s, t, *b)?;
+            tau_max = tau_max.max(vals[k][0].hypot(vals[k][1]));
+        }
+        nodal.push((t, vals));
+    }
+    Ok(FrictionResult { fx_n, fz_n, fx: fx_n / s.load, fz: fz_n / s.load, nodal, tau_max, seconds: t0.elapsed().as_secs_f64() })
+}
+
+/// The shear stress on the disc at (x, z) (units of a), or None outside the contact face.
+pub fn stress_at(fields: &FieldsOnFace, s: &FrictionSetup, x: f64, z: f64) -> Option<Result<[f64; 2], String>> {
+    let (t, b) = fields.locate(x, z)?;
+    Some(stress_in_triangle(fields, s, t, b))
+}
