@@ -29,7 +29,10 @@ pub struct Setup {
 impl Setup {
     pub fn new(ctx: &Context, scene: &Scene) -> Result<Setup, String> {
         let t0 = Instant::now();
-        let half = false;
+        let half = scene.uses_half_domain();
+        if half {
+            ctx.log("symmetry: the scene is symmetric about z = 0 (uniform entrainment, no spin): solving the half domain z <= 0 (effects.symmetry = \"off\" solves the full domain)");
+        }
         let mesh = super::dry::build_mesh(scene, half)?;
         let part = mesh::partition(&mesh, ctx.size);
         let quality = mesh::quality(&mesh);
@@ -57,10 +60,57 @@ pub struct PointResult {
     pub profile_x0: Vec<[f64; 2]>,
 }
 
+/// What the run simulates and what it skips, from the scene's `[effects]` (for the log
+/// and summary.json).
+pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
+    use crate::case::{CavitationModel, DensityModel, KinematicsModel, ViscosityModel};
+    let e = &scene.effects;
+    let mut simulated = vec![format!("Reynolds equation (P2, {} stabilisation) with the load balance for h0", scene.reynolds.stabilisation)];
+    let mut skipped = Vec::new();
+    simulated.push(format!("elastic deformation: P2 equivalent cube ({}), condensed onto the contact face", e.elasticity));
+    simulated.push(match e.viscosity {
+        ViscosityModel::Roelands => "pressure-viscosity: Roelands".to_string(),
+        ViscosityModel::Barus => "pressure-viscosity: Barus".to_string(),
+        ViscosityModel::Constant => {
+            skipped.push("pressure dependence of the viscosity (effects.viscosity = \"constant\")".to_string());
+            "viscosity: constant".to_string()
+        }
+    });
+    match e.density {
+        DensityModel::DowsonHigginson => simulated.push("compressibility: Dowson-Higginson".into()),
+        DensityModel::Incompressible => skipped.push("compressibility (effects.density = \"incompressible\")".into()),
+    }
+    match e.kinematics {
+        KinematicsModel::Spin => simulated.push("spin kinematics: non-uniform entrainment (Um(z), Wm(x)) from the ball and disc rotations".into()),
+        KinematicsModel::Uniform => skipped.push("spin (effects.kinematics = \"uniform\": U_B = U_BO, U_D = U_DO, W = 0)".into()),
+    }
+    match e.cavitation {
+        CavitationModel::Penalty => simulated.push(format!("cavitation: penalty, xi = {}", scene.reynolds.penalty)),
+        CavitationModel::Off => skipped.push("cavitation (effects.cavitation = \"none\": negative pressures kept)".into()),
+    }
+    match e.friction {
+        FrictionModel::Off => skipped.push("friction pass (effects.friction = \"none\")".into()),
+        f => simulated.push(format!("friction pass: {f} shear stresses, forces on the disc")),
+    }
+    if half {
+        skipped.push("the half z > 0 of the domain (symmetric scene; results mirrored)".into());
+    }
+    json!({
+        "lubrication": e.lubrication.as_str(), "elasticity": e.elasticity.as_str(), "viscosity": e.viscosity.as_str(),
+        "density": e.density.as_str(), "kinematics": e.kinematics.as_str(), "friction": e.friction.as_str(),
+        "cavitation": e.cavitation.as_str(),
+        "symmetry": if half { "half domain z <= 0" } else { "full domain" },
+        "simulated": simulated, "skipped": skipped,
+    })
+}
+
 pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let hertz = scene.hertz();
     ctx.log(format!("Hertz: a = {:.5e} m, p_H = {:.5e} Pa; lambda_bar = {:.4e}", hertz.a, hertz.ph, driver::lambda_bar(scene)));
     let setup = Setup::new(ctx, scene)?;
+    let report = effects_report(scene, setup.half);
+    ctx.log(format!("simulated: {}", report["simulated"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
+    ctx.log(format!("skipped: {}", report["skipped"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
     let solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
     if scene.is_sweep() {
         return super::sweep::run(ctx, scene, &setup, &solver);
@@ -124,7 +174,8 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
             None => Ok(None),
         }
     };
-    let r = &mesh.spec.contact;
+    // The scene's Reynolds rectangle (a half-domain solve is mirrored by FieldsOnFace).
+    let r = &crate::mesh::Rect { x0: scene.reynolds.x_min, x1: scene.reynolds.x_max, z0: scene.reynolds.z_min, z1: scene.reynolds.z_max };
     let profile = |from: [f64; 2], to: [f64; 2]| -> Result<Vec<Vec<f64>>, String> {
         let mut rows = Vec::new();
         for s in fields.profile(from, to, 601) {
@@ -187,11 +238,12 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
         "solver": {
             "newton_iterations": sol.newton_total, "snes_reason": sol.report.reason,
             "residual_norm": sol.report.residual_norm,
-            "dofs_elastic": n_u, "dofs_reynolds": n_p, "path": sol.steps,
+            "dofs_elastic": n_u, "dofs_reynolds": n_p, "path": sol.steps, "half_domain": setup.half,
             "penalty": scene.reynolds.penalty, "stabilisation": scene.reynolds.stabilisation.as_str(),
         },
         "timing": { "mesh_s": setup.mesh_s, "condensation_s": condensation_s, "assembly_s": sol.assembly_s, "solve_s": sol.solve_s, "post_s": t_post.elapsed().as_secs_f64(), "total_s": ctx.start.elapsed().as_secs_f64() },
         "peak_rss_mb": peak,
+        "effects": effects_report(scene, setup.half),
         "scene": scene,
     });
     if let Some(f) = &friction {
@@ -230,6 +282,15 @@ fn write_plots(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, prof
             tris.push(s.map(|k| xz[k]));
             pv.push(s.map(|k| p[k]));
             hv.push(s.map(|k| h[k]));
+        }
+    }
+    if fields.half() {
+        // The mirror image z -> -z of the half domain.
+        for i in 0..tris.len() {
+            let t: [[f64; 2]; 3] = tris[i];
+            tris.push(t.map(|q| [q[0], -q[1]]));
+            pv.push(pv[i]);
+            hv.push(hv[i]);
         }
     }
     // The film grows to tens of um at the rectangle's corners: colours and the profile's

@@ -115,6 +115,9 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
 
 /// Dispatches on what the scene asks to simulate.
 fn simulate(ctx: &Context, scene: &Scene) -> Result<(), String> {
+    for w in scene.warnings() {
+        ctx.log(format!("warning: {w}"));
+    }
     match scene.effects.lubrication {
         crate::case::LubricationModel::Dry => dry::run(ctx, scene),
         crate::case::LubricationModel::Reynolds => lubricated::run(ctx, scene),

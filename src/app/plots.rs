@@ -25,6 +25,15 @@ pub fn friction_plots(dir: &Path, fields: &FieldsOnFace, f: &FrictionResult, a: 
             tz.push(s.map(|k| vals[k][1] * 1e-6));
         }
     }
+    if fields.half() {
+        // Mirror image of the half domain: tau_yx even in z, tau_yz odd.
+        for i in 0..tris.len() {
+            let t: [[f64; 2]; 3] = tris[i];
+            tris.push(t.map(|q| [q[0], -q[1]]));
+            tx.push(tx[i]);
+            tz.push(tz[i].map(|v| -v));
+        }
+    }
     let opts = |label: &str| MapOpts {
         circle: Some((0.0, 0.0, 1.0)),
         colorbar_label: label.to_string(),

@@ -232,6 +232,49 @@ impl Scene {
         out
     }
 
+    /// Contradictions that do not stop the run but that the user should know about (each
+    /// names the fields). Printed at the start of a run.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        let e = &self.effects;
+        if e.lubrication == LubricationModel::Dry {
+            if e.friction != FrictionModel::Off {
+                w.push(format!("effects.friction = \"{}\" has no effect with effects.lubrication = \"none\" (no film, no shear pass)", e.friction));
+            }
+            return w;
+        }
+        let srr_swept = self.sweep.as_ref().is_some_and(|s| s.slide_to_roll.is_some());
+        if e.friction != FrictionModel::Off && e.kinematics == KinematicsModel::Uniform && self.operating.slide_to_roll == 0.0 && !srr_swept {
+            w.push(format!(
+                "effects.friction = \"{}\" with effects.kinematics = \"uniform\" and operating.slide_to_roll = 0: there is no sliding, the shear pass only sees the pressure-gradient (Poiseuille) stresses",
+                e.friction
+            ));
+        }
+        if let Some(l) = &self.lubricant {
+            if e.viscosity == ViscosityModel::Constant && l.pressure_viscosity.is_some() {
+                w.push("lubricant.pressure_viscosity is given but effects.viscosity = \"constant\" does not use it (only the Hamrock-Dowson reference film does)".into());
+            }
+        }
+        if e.kinematics == KinematicsModel::Uniform && self.operating.tilt_angle != 90.0 {
+            w.push(format!("operating.tilt_angle = {} deg is ignored by effects.kinematics = \"uniform\" (no spin)", self.operating.tilt_angle));
+        }
+        w
+    }
+
+    /// Whether the scene's kinematics and geometry are symmetric about the plane z = 0, so
+    /// that half the domain (z <= 0) can be solved: uniform entrainment without spin
+    /// (W_B = W_D = 0, U_B and U_D constant). Spin kinematics are not symmetric even at
+    /// lambda = 90 deg: the disc spins (U_D = omega_D (R_D + z)).
+    pub fn is_symmetric_z(&self) -> bool {
+        self.effects.kinematics == KinematicsModel::Uniform || self.effects.lubrication == LubricationModel::Dry
+    }
+
+    /// Whether the solver uses the half domain z <= 0: `effects.symmetry = "auto"` and a
+    /// symmetric scene.
+    pub fn uses_half_domain(&self) -> bool {
+        self.effects.symmetry == SymmetryMode::Auto && self.is_symmetric_z()
+    }
+
     /// Whether the scene sweeps its operating point (`[sweep]` given).
     pub fn is_sweep(&self) -> bool {
         self.sweep.is_some()

@@ -40,14 +40,21 @@ impl<'a> FieldsOnFace<'a> {
         self.layout.film(self.mesh, self.x, n)
     }
 
-    /// The contact triangle containing (x, z) and the point's barycentric coordinates.
+    /// Whether the mesh is the half domain z <= 0 of a symmetric scene.
+    pub fn half(&self) -> bool {
+        self.mesh.spec.half_z
+    }
+
+    /// The contact triangle containing (x, z) and the point's barycentric coordinates. On a
+    /// half domain a point z > 0 is located at its mirror image (x, -z).
     pub fn locate(&self, x: f64, z: f64) -> Option<(usize, [f64; 3])> {
+        let z = if self.half() { -z.abs() } else { z };
         self.locator.locate(self.mesh, x, z)
     }
 
     /// (P, H) at a point of the contact face, by P2 interpolation.
     pub fn at(&self, x: f64, z: f64) -> Option<(f64, f64)> {
-        let (t, b) = self.locator.locate(self.mesh, x, z)?;
+        let (t, b) = self.locate(x, z)?;
         let tri = self.mesh.contact_tris[t];
         let p = tri.map(|n| self.p_node(n));
         let h = tri.map(|n| self.h_node(n));

@@ -35,7 +35,8 @@ pub struct FrictionSetup<'a> {
 /// Result of the friction pass.
 #[derive(Debug, Clone)]
 pub struct FrictionResult {
-    /// Traction forces on the disc (N).
+    /// Traction forces on the disc (N), over the whole Reynolds rectangle (a half-domain
+    /// solve is mirrored).
     pub fx_n: f64,
     pub fz_n: f64,
     /// Friction coefficients Fx/L, Fz/L.
@@ -121,11 +122,19 @@ pub fn friction_pass(fields: &FieldsOnFace, s: &FrictionSetup) -> Result<Frictio
         }
         nodal.push((t, vals));
     }
+    if fields.half() {
+        // Half domain of a symmetric scene: tau_yx is even in z and tau_yz odd, so the
+        // mirror half doubles Fx and cancels Fz exactly.
+        fx_n *= 2.0;
+        fz_n = 0.0;
+    }
     Ok(FrictionResult { fx_n, fz_n, fx: fx_n / s.load, fz: fz_n / s.load, nodal, tau_max, seconds: t0.elapsed().as_secs_f64() })
 }
 
 /// The shear stress on the disc at (x, z) (units of a), or None outside the contact face.
+/// On a half domain a point z > 0 takes its mirror image's stress with tau_yz negated.
 pub fn stress_at(fields: &FieldsOnFace, s: &FrictionSetup, x: f64, z: f64) -> Option<Result<[f64; 2], String>> {
     let (t, b) = fields.locate(x, z)?;
-    Some(stress_in_triangle(fields, s, t, b))
+    let mirrored = fields.half() && z > 0.0;
+    Some(stress_in_triangle(fields, s, t, b).map(|v| if mirrored { [v[0], -v[1]] } else { v }))
 }
