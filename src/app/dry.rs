@@ -14,7 +14,12 @@ const HERTZ_SPLIT_DEPTH: u32 = 6;
 
 /// Builds the mesh described by the scene (every rank builds the same mesh).
 pub fn build_mesh(scene: &Scene, half_z: bool) -> Result<Mesh, String> {
-    let spec = mesh::MeshSpec {
+    mesh::generate(&mesh_spec(scene, half_z)).map_err(|e| format!("mesh: {e}"))
+}
+
+/// The mesh specification of the scene.
+pub fn mesh_spec(scene: &Scene, half_z: bool) -> mesh::MeshSpec {
+    mesh::MeshSpec {
         cube_edge: scene.mesh.cube_size,
         depth: scene.mesh.cube_size,
         half_z,
@@ -25,8 +30,7 @@ pub fn build_mesh(scene: &Scene, half_z: bool) -> Result<Mesh, String> {
             let w = scene.mesh.core_half_width;
             (mesh::Rect { x0: -w, x1: w, z0: -w, z1: if half_z { 0.0 } else { w } }, scene.mesh.core_size)
         }),
-    };
-    mesh::generate(&spec).map_err(|e| format!("mesh: {e}"))
+    }
 }
 
 /// Value of the y displacement (dimensionless U) at (x, z) on the contact face.

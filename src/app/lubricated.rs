@@ -33,8 +33,17 @@ impl Setup {
         if half {
             ctx.log("symmetry: the scene is symmetric about z = 0 (uniform entrainment, no spin): solving the half domain z <= 0 (effects.symmetry = \"off\" solves the full domain)");
         }
-        let mesh = super::dry::build_mesh(scene, half)?;
-        let part = mesh::partition(&mesh, ctx.size);
+        let rigid = scene.effects.elasticity == crate::case::ElasticityModel::Rigid;
+        let (mesh, part) = if rigid {
+            // Rigid solids: the Reynolds rectangle alone, no 3D mesh.
+            let m = mesh::face::face_mesh(&super::dry::mesh_spec(scene, half))?;
+            let p = mesh::face::face_partition(&m, ctx.size);
+            (m, p)
+        } else {
+            let m = super::dry::build_mesh(scene, half)?;
+            let p = mesh::partition(&m, ctx.size);
+            (m, p)
+        };
         let quality = mesh::quality(&mesh);
         let dofs = DofMap::new(&mesh, &part, ctx.size);
         let layout = Layout::new(&mesh, &part, &dofs, &mesh.spec.contact, half, ctx.size);
@@ -67,7 +76,10 @@ pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
     let e = &scene.effects;
     let mut simulated = vec![format!("Reynolds equation (P2, {} stabilisation) with the load balance for h0", scene.reynolds.stabilisation)];
     let mut skipped = Vec::new();
-    simulated.push(format!("elastic deformation: P2 equivalent cube ({}), condensed onto the contact face", e.elasticity));
+    match e.elasticity {
+        crate::case::ElasticityModel::Elastic => simulated.push("elastic deformation: P2 equivalent cube, condensed onto the contact face".into()),
+        crate::case::ElasticityModel::Rigid => skipped.push("elastic deformation and the 3D mesh (effects.elasticity = \"rigid\")".into()),
+    }
     simulated.push(match e.viscosity {
         ViscosityModel::Roelands => "pressure-viscosity: Roelands".to_string(),
         ViscosityModel::Barus => "pressure-viscosity: Barus".to_string(),
@@ -246,6 +258,10 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
         "effects": effects_report(scene, setup.half),
         "scene": scene,
     });
+    if scene.effects.elasticity == crate::case::ElasticityModel::Rigid {
+        // No elastic block: no condensation phase.
+        summary["timing"].as_object_mut().unwrap().remove("condensation_s");
+    }
     if let Some(f) = &friction {
         summary["friction"] = json!({ "model": scene.effects.friction.as_str(), "fx": f.fx, "fz": f.fz, "Fx_n": f.fx_n, "Fz_n": f.fz_n, "tau_max_pa": f.tau_max });
         summary["timing"]["friction_s"] = json!(f.seconds);

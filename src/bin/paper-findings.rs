@@ -135,7 +135,7 @@ fn figs_4_6(dir: &Path) -> Res<()> {
             let (hm8, hp8) = (interp(&p, "z_m", "h_m", -0.8 * a), interp(&p, "z_m", "h_m", 0.8 * a));
             let rel = (hp8 - hm8) / s.get(u, l, 0.0, "hc_m");
             if l == 0.5 {
-                asym.push((u, rel));
+                asym.push((u, hp_ - hm_, rel));
             }
             println!("2b. Ue = {u}, lambda = {l}: h(0, -a) = {:.4} um < h(0, +a) = {:.4} um: {};  (h(+0.8a) - h(-0.8a))/hc = {:.3}", hm_ * 1e6, hp_ * 1e6, verdict(hm_ < hp_), rel);
         }
@@ -147,7 +147,10 @@ fn figs_4_6(dir: &Path) -> Res<()> {
     }
     if asym.len() >= 2 {
         let (lo, hi) = (asym[0], asym[asym.len() - 1]);
-        println!("2c. asymmetry at lambda = 0.5 deg grows with Ue: {:.3} at Ue = {} vs {:.3} at Ue = {}: {}", hi.1, hi.0, lo.1, lo.0, verdict(hi.1 > lo.1));
+        println!(
+            "2c. asymmetry at lambda = 0.5 deg grows with Ue: h(0, +a) - h(0, -a) = {:.4} um at Ue = {} vs {:.4} um at Ue = {}: {}; relative to hc (at +-0.8a): {:.3} vs {:.3}",
+            hi.1 * 1e6, hi.0, lo.1 * 1e6, lo.0, verdict(hi.1 > lo.1), hi.2, lo.2
+        );
     }
     println!();
     Ok(())
@@ -221,10 +224,20 @@ fn cases(c1: &Path, c2: &Path) -> Res<()> {
         Ok((min(&tx), max(&tx), tz.iter().map(|x| x.abs()).fold(0.0, f64::max), corr, min(&tz).abs().min(max(&tz).abs())))
     };
     let (a1, b1, z1, c1r, _) = stats(c1)?;
-    let (a2, b2, z2, _, zz2) = stats(c2)?;
+    let (_, _, z2, _, zz2) = stats(c2)?;
+    // The sign zones of tau_yx in Case 2 lie on either side of a line across the rolling
+    // direction: look along the transverse centre line x = 0, inside the contact.
+    let transverse = |dir: &Path| -> Res<(f64, f64)> {
+        let rows = csv(&dir.join("profile_x0.csv"))?;
+        let a = num(&summary(dir)?, "hertz.a_m");
+        let t: Vec<f64> = rows.iter().filter(|r| f(r, "z_m").abs() <= a).map(|r| f(r, "tau_yx_pa")).collect();
+        Ok((t.iter().cloned().fold(f64::INFINITY, f64::min), t.iter().cloned().fold(f64::NEG_INFINITY, f64::max)))
+    };
+    let (a2, b2) = transverse(c2)?;
+    let (a1x, b1x) = transverse(c1)?;
     println!("6a. Case 1 (lambda = 90): tau_yx on the line in [{:.2}, {:.2}] MPa, correlation with p = {c1r:.3} (follows the pressure: > 0.8): {}", a1 * 1e-6, b1 * 1e-6, verdict(c1r > 0.8));
     let split = a2 < -0.1 * b2.abs().max(a2.abs()) && b2 > 0.1 * b2.abs().max(a2.abs());
-    println!("6b. Case 2 (lambda = 2): tau_yx on the line in [{:.2}, {:.2}] MPa (zones of opposite sign): {}", a2 * 1e-6, b2 * 1e-6, verdict(split));
+    println!("6b. Case 2 (lambda = 2): tau_yx on x = 0, |z| <= a in [{:.2}, {:.2}] MPa (zones of opposite sign: {}); Case 1: [{:.2}, {:.2}] MPa", a2 * 1e-6, b2 * 1e-6, verdict(split), a1x * 1e-6, b1x * 1e-6);
     println!("6c. max |tau_yz| on the line: Case 1 {:.2} MPa vs Case 2 {:.2} MPa (near zero in Case 1, strong in Case 2): {}", z1 * 1e-6, z2 * 1e-6, verdict(z1 < 0.3 * z2));
     println!("6d. Case 2 tau_yz has both signs on the line, the weaker zone reaching {:.2} MPa", zz2 * 1e-6);
     for (name, d) in [("Case 1", c1), ("Case 2", c2)] {

@@ -88,6 +88,9 @@ pub struct CondensedSystem<'a> {
     pub residual_evals: usize,
     pub jacobian_evals: usize,
     pub step_limits: Vec<f64>,
+    /// Freeze H0 at this value (the load row becomes H0 - value = 0): the pressure of a
+    /// given film, used to build a consistent start with rigid solids.
+    pub fixed_h0: Option<f64>,
 }
 
 impl<'a> CondensedSystem<'a> {
@@ -157,11 +160,17 @@ impl<'a> CondensedSystem<'a> {
             residual_evals: 0,
             jacobian_evals: 0,
             step_limits: Vec::new(),
+            fixed_h0: None,
         }
     }
 
     fn owned(&self) -> (usize, usize) {
         (self.layout.ranges[self.rank], self.layout.ranges[self.rank + 1])
+    }
+
+    /// The load integral of the pressure of x (dimensionless).
+    pub fn load(&self, x: &[f64]) -> f64 {
+        self.elements.iter().map(|e| (0..6).map(|k| e.w[k] * Self::element_p(x, e)[k]).sum::<f64>()).sum()
     }
 
     /// Local row of pressure unknown `d` if this rank owns it (None for -1 or another rank's).
@@ -205,11 +214,83 @@ impl<'a> CondensedSystem<'a> {
         e.p.map(|d| if d >= 0 { x[d as usize] } else { 0.0 })
     }
 
-    /// Dense local preallocation: every owned row is full.
+    /// Local preallocation: dense (every owned row full) with an elastic compliance;
+    /// with rigid solids the Reynolds stencil (element neighbours and H0) and the dense
+    /// load row.
     pub fn preallocation(&self) -> (Vec<i32>, Vec<i32>) {
         let nl = self.layout.local(self.rank);
         let n = self.layout.total();
-        (vec![nl as i32; nl], vec![(n - nl) as i32; nl])
+        if !self.comp.is_rigid() {
+            return (vec![nl as i32; nl], vec![(n - nl) as i32; nl]);
+        }
+        let (lo, hi) = self.owned();
+        let np = self.layout.n_p;
+        let mut cols: Vec<std::collections::BTreeSet<usize>> = vec![Default::default(); hi - lo];
+        for e in self.elements.iter().filter(|e| e.mine) {
+            for i in 0..6 {
+                let Some(l) = self.own_row(e.p[i]) else { continue };
+                cols[l].insert(np);
+                cols[l].insert(e.p[i] as usize);
+                for k in 0..6 {
+                    if e.p[k] >= 0 {
+                        cols[l].insert(e.p[k] as usize);
+                    }
+                }
+            }
+        }
+        if hi > np {
+            cols[np - lo] = (0..=np).collect();
+        }
+        let d = cols.iter().map(|c| c.iter().filter(|&&j| j >= lo && j < hi).count() as i32).collect::<Vec<_>>();
+        let o = cols.iter().zip(&d).map(|(c, &dd)| c.len() as i32 - dd).collect();
+        (d, o)
+    }
+
+    /// The Jacobian with rigid solids (H = H0 + gap): sparse, element by element.
+    fn jacobian_rigid(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
+        let np = self.layout.n_p;
+        let (_, hi) = self.owned();
+        let h = self.film(x);
+        let fluid = self.fluid();
+        j.zero()?;
+        for e in self.elements.iter().filter(|e| e.mine) {
+            let p = Self::element_p(x, e);
+            let he = e.face.map(|f| h[f]);
+            let out = self.eval(e, &p, &he, &fluid);
+            for i in 0..6 {
+                let Some(_) = self.own_row(e.p[i]) else { continue };
+                let r = e.p[i] as usize;
+                let s = self.row_scale[r];
+                let mut cols = Vec::with_capacity(7);
+                let mut vals = Vec::with_capacity(7);
+                for k in 0..6 {
+                    if e.p[k] >= 0 {
+                        cols.push(e.p[k]);
+                        vals.push(s * out.dr_dp[i][k]);
+                    }
+                }
+                // dH/dH0 = 1 at every node.
+                cols.push(np as i32);
+                vals.push(s * out.dr_dh[i].iter().sum::<f64>());
+                j.add_values(&[r as i32], &cols, &vals)?;
+            }
+        }
+        for &(jn, _, area) in &self.penalty_nodes {
+            let (_, dv) = penalty_law(x[jn]);
+            let dv = dv.max(if CAVITATION_SMOOTHING > 0.0 { 0.0 } else { 1.0 });
+            j.add_values(&[jn as i32], &[jn as i32], &[self.row_scale[jn] * self.params.penalty * area * dv])?;
+        }
+        if hi > np {
+            if self.fixed_h0.is_some() {
+                j.add_values(&[np as i32], &[np as i32], &[1.0])?;
+            } else {
+                for e in &self.elements {
+                    let (cols, vals): (Vec<i32>, Vec<f64>) = (0..6).filter(|&k| e.p[k] >= 0).map(|k| (e.p[k], e.w[k])).unzip();
+                    j.add_values(&[np as i32], &cols, &vals)?;
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Developer aid (EHL_DEBUG): appends the iterate's centre lines to /tmp/ehl_debug_lines.csv.
@@ -313,7 +394,10 @@ impl Problem for CondensedSystem<'_> {
                     (0..6).map(|k| e.w[k] * p[k]).sum::<f64>()
                 })
                 .sum();
-            r[self.layout.h0() - lo] = load - self.params.load;
+            r[self.layout.h0() - lo] = match self.fixed_h0 {
+                Some(h0) => x[self.layout.h0()] - h0,
+                None => load - self.params.load,
+            };
         }
         if std::env::var_os("EHL_DEBUG").is_some() {
             if let Some(mesh) = self.debug_mesh {
@@ -366,6 +450,9 @@ impl Problem for CondensedSystem<'_> {
 
     fn jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
         self.jacobian_evals += 1;
+        if self.comp.is_rigid() && self.pseudo.is_none() {
+            return self.jacobian_rigid(x, j);
+        }
         let (lo, hi) = self.owned();
         let n = self.layout.total();
         let np = self.layout.n_p;
@@ -386,9 +473,11 @@ impl Problem for CondensedSystem<'_> {
                     // H = H0 + gap - U_y with U_y = C P: dH/dP = -C, dH/dH0 = 1.
                     let g = out.dr_dh[i][k];
                     if g != 0.0 {
-                        let crow = &self.comp.c[e.face[k] * np..(e.face[k] + 1) * np];
-                        for (a, c) in row[..np].iter_mut().zip(crow) {
-                            *a -= g * c;
+                        if !self.comp.is_rigid() {
+                            let crow = &self.comp.c[e.face[k] * np..(e.face[k] + 1) * np];
+                            for (a, c) in row[..np].iter_mut().zip(crow) {
+                                *a -= g * c;
+                            }
                         }
                         row[np] += g;
                     }
@@ -406,9 +495,11 @@ impl Problem for CondensedSystem<'_> {
                 let row = &mut buf[(jn - lo) * n..(jn - lo + 1) * n];
                 // d(rho H)/dP_k = rho' H delta_jk - rho C[f, k]; d/dH0 = rho.
                 row[jn] += area * drho * h[f] / dt;
-                let crow = &self.comp.c[f * np..(f + 1) * np];
-                for (a, c) in row[..np].iter_mut().zip(crow) {
-                    *a -= area * rho * c / dt;
+                if !self.comp.is_rigid() {
+                    let crow = &self.comp.c[f * np..(f + 1) * np];
+                    for (a, c) in row[..np].iter_mut().zip(crow) {
+                        *a -= area * rho * c / dt;
+                    }
                 }
                 row[np] += area * rho / dt;
             }

@@ -163,7 +163,12 @@ impl<'a> EhlSolver<'a> {
         }
         petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
         let t0 = std::time::Instant::now();
-        let comp = if monolithic {
+        let rigid = scene.effects.elasticity == crate::case::ElasticityModel::Rigid;
+        let comp = if rigid {
+            let p_nodes: Vec<u32> = mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect();
+            ctx.log(format!("rigid solids: no elastic unknowns, H = H0 + (X^2 + Z^2)/2; sparse Newton on {} pressure unknowns", p_nodes.len()));
+            Some(crate::solid::condense::Compliance::rigid(mesh.contact_nodes.clone(), p_nodes))
+        } else if monolithic {
             None
         } else {
             let eq = scene.equivalent_solid();
@@ -233,7 +238,12 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
             }
             let uy0 = system.uy(&x0);
             x0[cl.h0()] = start_h0(scene, mesh, &|n| uy0[cl.face_index[n as usize] as usize])?;
-            "the Hertz start"
+            if comp.is_rigid() {
+                rigid_start(ctx, &mut system, &mut x0, (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]), cl.local(ctx.rank))?;
+                "the rigid start"
+            } else {
+                "the Hertz start"
+            }
         }
     };
     let (d_nnz, o_nnz) = system.preallocation();
@@ -258,6 +268,74 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     }
     x[layout.h0 as usize] = out.x[cl.h0()];
     Ok(EhlSolution { x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s })
+}
+
+/// A consistent start for rigid solids. The Hertz start is far from a rigid solution, and
+/// at P = 0 the Reynolds rows do not depend on H0 (dR/dH0 = div(3 H^2 grad P) = 0), so
+/// Newton on (P, H0) takes useless steps. Instead: solve the pressure of a frozen film
+/// (P only), and adjust H0 until its load is within 2 % of the target, by a secant method
+/// on log W(log H0) (the first step assumes W ~ 1/H0); each frozen-film solve starts from
+/// the previous pressure scaled to the target load. The full Newton finishes from there.
+fn rigid_start(ctx: &Context, system: &mut CondensedSystem, x0: &mut [f64], (lo, hi): (usize, usize), local: usize) -> Result<(), String> {
+    let pe = |e: petsc::PetscError| e.to_string();
+    let comm = petsc::comm_world();
+    let n = x0.len();
+    let np = n - 1;
+    x0[..np].iter_mut().for_each(|p| *p = 0.0);
+    let mut h0 = x0[np];
+    let (d, o) = system.preallocation();
+    let j = Matrix::new_aij(comm, local, &d, &o).map_err(pe)?;
+    let x = Vector::new(comm, local).map_err(pe)?;
+    // Its own options prefix: the frozen-film solves cross the cavitation penalty's kink
+    // node by node and may need more iterations than the main Newton's default.
+    for (k, v) in [("-rigid_start_snes_max_it", "200"), ("-rigid_start_snes_rtol", "1e-8"), ("-rigid_start_snes_stol", "0"), ("-rigid_start_snes_linesearch_type", "bt")] {
+        petsc::options::set_default(k, v).map_err(pe)?;
+    }
+    petsc::ksp::set_direct_solver_defaults("rigid_start_").map_err(pe)?;
+    let snes = Snes::new(comm, "rigid_start_").map_err(pe)?;
+    let target = system.params.load;
+    let mut prev: Option<(f64, f64)> = None;
+    let mut result = Ok(());
+    for it in 0..12 {
+        system.fixed_h0 = Some(h0);
+        x0[np] = h0;
+        system.scale_rows(x0).map_err(pe)?;
+        x.set_local_values(&x0[lo..hi]).map_err(pe)?;
+        let r = snes.solve(system, &x, &j).map_err(pe)?;
+        if !r.converged {
+            if prev.is_none() && it < 4 {
+                // A too thin first guess: the frozen film is much thinner than the
+                // solution's, its pressure enormous. Start over from a thicker film.
+                ctx.log(format!("rigid start {}: H0 = {h0:.5e}: {} ; trying a 4 times thicker film", it + 1, r.reason));
+                h0 *= 4.0;
+                x0[..np].iter_mut().for_each(|p| *p = 0.0);
+                continue;
+            }
+            result = Err(format!("rigid start: the pressure of the film H0 = {h0:.4e} did not converge ({})", r.reason));
+            break;
+        }
+        let xs = x.gather_all().map_err(pe)?;
+        x0[..np].copy_from_slice(&xs[..np]);
+        let w = system.load(x0);
+        ctx.log(format!("rigid start {}: H0 = {h0:.5e}, load {:.4} of the target ({} iterations)", it + 1, w / target, r.iterations));
+        if !(w > 0.0) || (w / target - 1.0).abs() < 0.02 {
+            break;
+        }
+        // Slope of log W against log H0: secant once two points are known, else -1.
+        let slope = match prev {
+            Some((h_old, w_old)) if (h0 / h_old).ln().abs() > 1e-12 => ((w / w_old).ln() / (h0 / h_old).ln()).clamp(-4.0, -0.25),
+            _ => -1.0,
+        };
+        prev = Some((h0, w));
+        let factor = ((target / w).ln() / slope).clamp(-2.0, 2.0).exp();
+        h0 *= factor;
+        // The pressure scales roughly with the load: start the next solve from it.
+        let s = target / w;
+        x0[..np].iter_mut().for_each(|p| *p *= s);
+    }
+    system.fixed_h0 = None;
+    x0[np] = h0;
+    result
 }
 
 /// The monolithic path: U, P and H0 in one sparse system.

@@ -22,6 +22,7 @@ mod partition;
 mod quality;
 mod refine;
 pub mod spec;
+pub mod face;
 
 #[cfg(test)]
 mod tests;

@@ -52,6 +52,13 @@ fn sorted_by_key(keys: &[u64]) -> Vec<u32> {
 /// of their centroids and cut into contiguous chunks of equal size (within
 /// one); nodes owned by the lowest rank touching them. Pure function of the
 /// mesh, hence identical on every rank.
+/// All nodes of `mesh` in Morton order of their coordinates (ties by id).
+pub fn morton_order(mesh: &Mesh) -> Vec<u32> {
+    let (lo, hi) = mesh.spec.bounds();
+    let keys: Vec<u64> = mesh.nodes.iter().map(|p| point_key(p, &lo, &hi)).collect();
+    sorted_by_key(&keys)
+}
+
 pub fn partition(mesh: &Mesh, nranks: usize) -> Partition {
     assert!(nranks > 0, "partition: nranks must be > 0");
     let (lo, hi) = mesh.spec.bounds();

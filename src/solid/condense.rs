@@ -39,8 +39,21 @@ pub struct Compliance {
 }
 
 impl Compliance {
+    /// The compliance of rigid solids: U_y = 0 whatever the pressure (no matrix stored).
+    pub fn rigid(rows: Vec<u32>, cols: Vec<u32>) -> Compliance {
+        Compliance { rows, cols, c: Vec::new(), seconds: 0.0, elastic_unknowns: 0 }
+    }
+
+    /// Whether this is the rigid (zero) compliance.
+    pub fn is_rigid(&self) -> bool {
+        self.c.is_empty()
+    }
+
     /// U_y at every face node for the nodal pressures `p` (in `cols` order).
     pub fn apply(&self, p: &[f64]) -> Vec<f64> {
+        if self.is_rigid() {
+            return vec![0.0; self.rows.len()];
+        }
         let n = self.cols.len();
         self.c.chunks_exact(n).map(|row| row.iter().zip(p).map(|(a, b)| a * b).sum()).collect()
     }
