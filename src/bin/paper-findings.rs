@@ -180,11 +180,22 @@ fn figs_7_8(dir: &Path) -> Res<()> {
     let slopes: Vec<f64> = LAMBDAS.iter().map(|&l| (fx(l, 0.01) - fx(l, -0.01)) / 0.02).collect();
     let decreasing = slopes.windows(2).all(|w| w[1] <= w[0] * 1.001);
     println!("4b. slope dfx/dSRR at SRR = 0 for lambda = {:?}: {:?}; smaller lambda, smaller slope: {}", LAMBDAS, slopes.iter().map(|x| (x * 1e3).round() / 1e3).collect::<Vec<_>>(), verdict(decreasing));
-    for l in [7.0, 4.0, 2.0, 1.0, 0.5] {
-        let r: Vec<f64> = [0.02, 0.05, 0.1].iter().map(|&sr| fx(l, sr) / fx(90.0, sr)).collect();
-        let spread = r.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - r.iter().cloned().fold(f64::INFINITY, f64::min);
-        println!("4c. lambda = {l}: fx/fx90 at SRR = 2, 5, 10 % = {:?} (roughly proportional: spread < 0.15): {}", r.iter().map(|x| (x * 1e3).round() / 1e3).collect::<Vec<_>>(), verdict(spread < 0.15));
+    // "Friction falls roughly in proportion" for SRR <= 10 % and lambda <= 7 deg: read as
+    // fx proportional to lambda, i.e. fx(lambda) / fx(lambda') = lambda / lambda'.
+    let pairs = [(4.0, 7.0), (2.0, 4.0), (1.0, 2.0), (0.5, 1.0)];
+    let mut worst: f64 = 0.0;
+    for &sr in &[0.02, 0.05, 0.1] {
+        let r: Vec<String> = pairs
+            .iter()
+            .map(|&(l1, l2)| {
+                let q = fx(l1, sr) / fx(l2, sr);
+                worst = worst.max((q / (l1 / l2) - 1.0).abs());
+                format!("fx({l1})/fx({l2}) = {q:.3} (lambda ratio {:.3})", l1 / l2)
+            })
+            .collect();
+        println!("4c. SRR = {} %: {}", sr * 100.0, r.join(", "));
     }
+    println!("4c. fx proportional to lambda for lambda <= 7 deg, SRR <= 10 %: worst deviation of the ratios {:.0} % (roughly: < 20 %): {}", 100.0 * worst, verdict(worst < 0.2));
     let max_fx = s.rows.iter().map(|r| f(r, "fx").abs()).filter(|x| x.is_finite()).fold(0.0, f64::max);
     let max_fz = s.rows.iter().map(|r| f(r, "fz").abs()).filter(|x| x.is_finite()).fold(0.0, f64::max);
     println!("5a. max |fz| / max |fx| = {:.2e} / {:.2e} = {:.1e} (about two orders: in [3e-3, 3e-2]): {}", max_fz, max_fx, max_fz / max_fx, verdict((3e-3..3e-2).contains(&(max_fz / max_fx))));
