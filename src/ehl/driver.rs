@@ -110,9 +110,14 @@ fn stabilisation(scene: &Scene, penalty: f64) -> crate::reynolds::element::Stabi
         delta: std::env::var("EHL_SUPG_DELTA").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0),
         id: scene.reynolds.artificial_diffusion,
         penalty,
+        // An incompressible lubricant has no film Peclet number (d rho/dP = 0: the
+        // pressure is not advected, the element falls back to |v|); with that larger tau
+        // the diffusive part of the strong residual stalls Newton (measured on
+        // cases/examples/barus-newtonian.toml), so "supg" keeps the Couette residual there.
         residual: match choice {
             S::SupgExact => StrongResidual::Full,
             S::SupgCouette => StrongResidual::Couette,
+            _ if scene.effects.density == crate::case::DensityModel::Incompressible => StrongResidual::Couette,
             _ => StrongResidual::FrozenLubricant,
         },
         film_peclet: true,
