@@ -30,6 +30,11 @@ struct Cli {
     /// Print only errors
     #[arg(long)]
     quiet: bool,
+    /// Solve the scene on N meshes halving the contact-zone size (0.5a, 0.25a, then a
+    /// 0.125a, 0.0625a, ... core), estimate converged values by Richardson extrapolation;
+    /// writes study.csv, study.md and error plots
+    #[arg(long, value_name = "N")]
+    convergence_study: Option<usize>,
     /// Print the scene-file reference (every key, unit, range, default) as Markdown and exit
     #[arg(long)]
     scene_reference: bool,
@@ -65,6 +70,7 @@ fn main() {
         petsc_args: cli.petsc_args,
         check_only: cli.check,
         quiet: cli.quiet,
+        study_levels: cli.convergence_study,
     };
     let code = ehl_petsc::app::run(world, opts);
     drop(universe);

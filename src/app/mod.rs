@@ -4,6 +4,7 @@ pub mod collective;
 pub mod dry;
 pub mod lubricated;
 pub mod plots;
+pub mod study;
 pub mod sweep;
 
 use crate::case::Scene;
@@ -21,6 +22,8 @@ pub struct RunOptions {
     pub petsc_args: Vec<String>,
     pub check_only: bool,
     pub quiet: bool,
+    /// `--convergence-study N`: solve the scene on N meshes (see [`study`]).
+    pub study_levels: Option<usize>,
 }
 
 /// Shared state of one run on one rank.
@@ -101,7 +104,11 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     };
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
-    let result = simulate(&ctx, &scene);
+    let result = match opts.study_levels {
+        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => study::run(&ctx, &scene, n),
+        Some(_) => Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into()),
+        None => simulate(&ctx, &scene),
+    };
     let code = match collective::agree(&ctx.world, result) {
         Ok(()) => 0,
         Err(e) => {

@@ -1,0 +1,231 @@
+//! Convergence study (`--convergence-study N`): one scene solved on a ladder of N meshes,
+//! each halving the element size over the contact zone, with the unknowns, Newton
+//! iterations, time per phase and peak memory of each level, the converged values
+//! estimated by Richardson extrapolation with the observed order, and the error each level
+//! makes against them. Writes `level_K/` (the usual outputs), `study.csv`, `study.md` and
+//! `study_error_vs_unknowns.png`, `study_error_vs_time.png`.
+//!
+//! Ladder of contact-zone sizes h (units of a): 0.5, 0.25 (plain meshes, `mesh.contact_size`),
+//! then 0.125, 0.0625, ... as a core over |X|, |Z| <= 1.25 on the 0.25a mesh (the paper
+//! scenes' construction). The scene's own `[mesh]` sizes are replaced.
+use super::lubricated::{post_point, PointResult, Setup};
+use super::{collective, Context};
+use crate::case::Scene;
+use crate::ehl::driver::EhlSolver;
+use crate::output::plot::{line_plot, LineOpts, Series, Style};
+use std::time::Instant;
+
+/// Contact-zone size of level k (units of a).
+pub fn level_size(k: usize) -> f64 {
+    0.5 / (1u64 << k) as f64
+}
+
+/// The scene with the mesh of contact-zone size `h`.
+pub fn level_scene(scene: &Scene, h: f64) -> Scene {
+    let mut s = scene.clone();
+    if h >= 0.25 {
+        s.mesh.contact_size = h;
+        s.mesh.core_size = 0.0;
+    } else {
+        s.mesh.contact_size = 0.25;
+        s.mesh.core_size = h;
+        s.mesh.core_half_width = 1.25;
+    }
+    s
+}
+
+/// Richardson extrapolation of a sequence on meshes halving h: from the last three values,
+/// the observed order p = log2(d1/d2) and q_inf = q3 + d2/(2^p - 1). None when the last two
+/// differences do not shrink monotonically (no asymptotic range yet).
+pub fn richardson(q: &[f64]) -> Option<(f64, f64)> {
+    if q.len() < 3 {
+        return None;
+    }
+    let n = q.len();
+    let (d1, d2) = (q[n - 2] - q[n - 3], q[n - 1] - q[n - 2]);
+    if d2 == 0.0 {
+        return Some((q[n - 1], f64::INFINITY));
+    }
+    if d1 * d2 <= 0.0 || d2.abs() >= d1.abs() {
+        return None;
+    }
+    let p = (d1 / d2).log2();
+    Some((q[n - 1] + d2 / (2f64.powf(p) - 1.0), p))
+}
+
+struct Level {
+    /// Why the level failed (None: converged).
+    failed: Option<String>,
+    h: f64,
+    n_u: usize,
+    n_p: usize,
+    its: usize,
+    mesh_s: f64,
+    condensation_s: f64,
+    newton_s: f64,
+    total_s: f64,
+    rss_mb: f64,
+    r: PointResult,
+}
+
+pub fn run(ctx: &Context, scene: &Scene, levels: usize) -> Result<(), String> {
+    if !(2..=6).contains(&levels) {
+        return Err(format!("--convergence-study {levels}: the number of levels must be in [2, 6] (level 6 has a 0.015625a core)"));
+    }
+    if scene.is_sweep() {
+        return Err("--convergence-study solves one operating point: remove [sweep] from the scene".into());
+    }
+    let mut rows: Vec<Level> = Vec::new();
+    for k in 0..levels {
+        let h = level_size(k);
+        let sc = level_scene(scene, h);
+        ctx.log(format!("convergence study: level {} of {levels}, contact-zone size {h} a", k + 1));
+        let t0 = Instant::now();
+        let dir = ctx.out_dir.join(format!("level_{}", k + 1));
+        let made = if ctx.rank == 0 { std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display())) } else { Ok(()) };
+        collective::agree(&ctx.world, made)?;
+        let setup = Setup::new(ctx, &sc)?;
+        let solver = EhlSolver::new(ctx, &sc, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
+        let (n_u, n_p) = setup.layout.counts();
+        let solved = solver.solve(ctx, &sc, None).and_then(|sol| collective::agree(&ctx.world, post_point(ctx, &sc, &setup, &sol, solver.condensation_s, &dir)).map(|r| (sol, r)));
+        let rss_mb = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
+        let level = match solved {
+            Ok((sol, r)) => Level { failed: None, h, n_u, n_p, its: sol.newton_total, mesh_s: setup.mesh_s, condensation_s: solver.condensation_s, newton_s: sol.solve_s, total_s: t0.elapsed().as_secs_f64(), rss_mb, r },
+            Err(e) => {
+                // A level too coarse for the load fails honestly: recorded, skipped, the
+                // ladder goes on.
+                ctx.log(format!("convergence study: level {} FAILED: {e}", k + 1));
+                if ctx.rank == 0 {
+                    let _ = std::fs::remove_dir_all(&dir);
+                }
+                Level { failed: Some(e), h, n_u, n_p, its: 0, mesh_s: setup.mesh_s, condensation_s: solver.condensation_s, newton_s: 0.0, total_s: t0.elapsed().as_secs_f64(), rss_mb, r: PointResult::default() }
+            }
+        };
+        rows.push(level);
+    }
+    let ok = rows.iter().filter(|r| r.failed.is_none()).count();
+    if ok < 2 {
+        return Err(format!("convergence study: only {ok} of {levels} levels converged; nothing to compare"));
+    }
+    if ctx.rank == 0 {
+        write_outputs(ctx, scene, &rows)?;
+    }
+    Ok(())
+}
+
+fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level]) -> Result<(), String> {
+    // Failed levels are listed, then left out of the estimates (the ladder still halves h
+    // between the converged levels, which follow each other).
+    let failed: Vec<String> = all.iter().enumerate().filter_map(|(k, r)| r.failed.as_ref().map(|e| format!("level {} (h = {} a): {e}", k + 1, r.h))).collect();
+    let rows: Vec<&Level> = all.iter().filter(|r| r.failed.is_none()).collect();
+    let level_no = |r: &Level| all.iter().position(|q| std::ptr::eq(q, r)).unwrap() + 1;
+    let friction = rows.iter().all(|r| r.r.fx.is_some());
+    let mut quantities: Vec<(&str, Vec<f64>)> = vec![
+        ("hc", rows.iter().map(|r| r.r.hc).collect()),
+        ("hm", rows.iter().map(|r| r.r.hm).collect()),
+        ("pmax", rows.iter().map(|r| r.r.pmax).collect()),
+    ];
+    if friction {
+        quantities.push(("fx", rows.iter().map(|r| r.r.fx.unwrap()).collect()));
+        quantities.push(("fz", rows.iter().map(|r| r.r.fz.unwrap()).collect()));
+    }
+    // Reference: the Richardson estimate, or the finest level when there is none.
+    let refs: Vec<(f64, Option<f64>)> = quantities.iter().map(|(_, q)| richardson(q).map(|(v, p)| (v, Some(p))).unwrap_or((*q.last().unwrap(), None))).collect();
+    let err = |qi: usize, k: usize| (quantities[qi].1[k] - refs[qi].0).abs() / refs[qi].0.abs();
+    // CSV
+    let mut csv = String::from("level,h_a,dofs_elastic,dofs_reynolds,newton_iterations,mesh_s,condensation_s,newton_s,total_s,peak_rss_mb");
+    for (name, _) in &quantities {
+        csv.push_str(&format!(",{name},{name}_rel_error"));
+    }
+    csv.push('\n');
+    for (k, r) in rows.iter().enumerate() {
+        csv.push_str(&format!("{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.0}", level_no(r), r.h, r.n_u, r.n_p, r.its, r.mesh_s, r.condensation_s, r.newton_s, r.total_s, r.rss_mb));
+        for (qi, (_, q)) in quantities.iter().enumerate() {
+            csv.push_str(&format!(",{:e},{:e}", q[k], err(qi, k)));
+        }
+        csv.push('\n');
+    }
+    let path = ctx.out_dir.join("study.csv");
+    crate::output::write_atomic(&path, csv.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    // Markdown
+    let mut md = format!("# Convergence study: {} ({} ranks)\n\n| level | h (a) | elastic unknowns | pressure unknowns | Newton its | mesh + condensation + Newton = total (s) | peak RSS/rank (MB) |", scene.name, ctx.size);
+    for (name, _) in &quantities {
+        md.push_str(&format!(" {name} | error |"));
+    }
+    md.push_str(&format!("\n|{}\n", "---|".repeat(7 + 2 * quantities.len())));
+    for (k, r) in rows.iter().enumerate() {
+        md.push_str(&format!("| {} | {} | {} | {} | {} | {:.1} + {:.1} + {:.1} = {:.1} | {:.0} |", level_no(r), r.h, r.n_u, r.n_p, r.its, r.mesh_s, r.condensation_s, r.newton_s, r.total_s, r.rss_mb));
+        for (qi, (_, q)) in quantities.iter().enumerate() {
+            md.push_str(&format!(" {:.5e} | {:.2} % |", q[k], 100.0 * err(qi, k)));
+        }
+        md.push('\n');
+    }
+    for f in &failed {
+        md.push_str(&format!("\nFailed: {f}\n"));
+    }
+    md.push_str("\nReference values:\n\n");
+    for (qi, (name, _)) in quantities.iter().enumerate() {
+        match refs[qi].1 {
+            Some(p) => md.push_str(&format!("- {name}: {:.5e} (Richardson, observed order {p:.2})\n", refs[qi].0)),
+            None if rows.len() < 3 => md.push_str(&format!("- {name}: {:.5e} = the finest level (fewer than three converged levels: no extrapolation)\n", refs[qi].0)),
+            None => md.push_str(&format!("- {name}: {:.5e} = the finest level (the last differences do not shrink: not in the asymptotic range, no extrapolation)\n", refs[qi].0)),
+        }
+    }
+    // Against the finest level itself the error is zero by construction: with no
+    // extrapolation only the coarser levels can be judged.
+    let extrapolated = refs[0].1.is_some() && refs[1].1.is_some();
+    let judged = if extrapolated { rows.len() } else { rows.len() - 1 };
+    let within = |tol: f64| rows.iter().take(judged).enumerate().find(|(k, _)| err(0, *k) < tol && err(1, *k) < tol).map(|(_, r)| format!("level {} ({:.1} s)", level_no(r), r.total_s)).unwrap_or_else(|| "no level".into());
+    md.push_str(&format!(
+        "\nhc and hm within 1 % of the reference: {}; within 0.5 %: {}{}.\n",
+        within(0.01),
+        within(0.005),
+        if extrapolated { "" } else { " (the reference is the finest level, which is not judged)" }
+    ));
+    let path = ctx.out_dir.join("study.md");
+    crate::output::write_atomic(&path, md.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    ctx.log(format!("convergence study written: {} and study.csv\n{md}", path.display()));
+    // Plots: relative error against unknowns and against wall time (levels with a nonzero
+    // error: the finest is the reference when there is no extrapolation).
+    for (name, xlabel, xs) in [
+        ("study_error_vs_unknowns.png", "unknowns (elastic + pressure)", rows.iter().map(|r| (r.n_u + r.n_p) as f64).collect::<Vec<_>>()),
+        ("study_error_vs_time.png", "wall time per level (s)", rows.iter().map(|r| r.total_s).collect::<Vec<_>>()),
+    ] {
+        let series: Vec<Series> = quantities
+            .iter()
+            .enumerate()
+            .map(|(qi, (qn, _))| {
+                let pts: Vec<(f64, f64)> = (0..rows.len()).map(|k| (xs[k], err(qi, k))).filter(|p| p.1 > 0.0).collect();
+                Series::new(qn, pts.iter().map(|p| p.0).collect(), pts.iter().map(|p| p.1 * 100.0).collect(), Style::LinePoints)
+            })
+            .filter(|s| !s.x.is_empty())
+            .collect();
+        if series.is_empty() {
+            continue;
+        }
+        let lo = LineOpts { log_x: true, log_y: true, ..LineOpts::default() };
+        crate::output::write_atomic_with(&ctx.out_dir.join(name), |t| line_plot(t, &format!("{}: error against the reference", scene.name), xlabel, "relative error (%)", &series, &lo))?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn richardson_recovers_a_second_order_sequence() {
+        // q(h) = 1 + 3 h^2 at h = 0.5, 0.25, 0.125.
+        let q: Vec<f64> = [0.5f64, 0.25, 0.125].iter().map(|h| 1.0 + 3.0 * h * h).collect();
+        let (v, p) = richardson(&q).unwrap();
+        assert!((v - 1.0).abs() < 1e-12 && (p - 2.0).abs() < 1e-12, "{v} {p}");
+        // Oscillating or growing differences: no estimate.
+        assert!(richardson(&[1.0, 1.1, 1.05]).is_none());
+        assert!(richardson(&[1.0, 1.1, 1.3]).is_none());
+    }
+
+    #[test]
+    fn ladder_halves_the_contact_zone_size() {
+        assert_eq!([0, 1, 2, 3].map(level_size), [0.5, 0.25, 0.125, 0.0625]);
+    }
+}
