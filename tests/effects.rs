@@ -59,34 +59,10 @@ fn half_domain_matches_full_domain_with_half_the_unknowns() {
 #[test]
 fn isoviscous_rigid_regime_without_a_3d_mesh() {
     let dir = scratch("effects-ir");
-    let scene = r#"
-name = "ir"
-[effects]
-elasticity = "rigid"
-viscosity = "constant"
-density = "incompressible"
-kinematics = "uniform"
-friction = "none"
-[geometry]
-ball_radius = 0.08
-[materials.ball]
-young_modulus = 210e9
-poisson_ratio = 0.3
-[materials.disc]
-young_modulus = 210e9
-poisson_ratio = 0.3
-[lubricant]
-viscosity = 0.012
-[operating]
-load = 10.0
-entrainment_speed = 2.0
-[reynolds]
-x_min = -12.0
-x_max = 6.0
-z_min = -12.0
-z_max = 12.0
-"#;
-    let path = write_scene(&dir, "ir.toml", scene);
+    // The example scene (cases/examples/rigid-isoviscous.toml): L = 10 N, Ue = 2 m/s,
+    // eta = 0.012 Pa s, R = 0.08 m, Reynolds rectangle [-12, 6] x [-12, 12] a.
+    let scene = std::fs::read_to_string(repo().join("cases/examples/rigid-isoviscous.toml")).unwrap();
+    let path = write_scene(&dir, "ir.toml", &scene);
     let out_dir = dir.join("out");
     let out = mpirun(2, &[path.as_str(), "--output", out_dir.to_str().unwrap()]);
     let t = text(&out);

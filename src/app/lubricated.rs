@@ -147,7 +147,7 @@ pub fn friction_setup<'a>(scene: &Scene, eta: &'a dyn Fn(f64) -> f64, rect: crat
 /// rank 0 the friction pass and every output file in `dir` (profiles, plots, VTU,
 /// summary.json last). Returns the point's numbers (rank 0; the others return the film
 /// numbers without friction). Not collective except for the peak-memory reduction.
-pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution, condensation_s: f64, dir: &Path) -> Result<PointResult, String> {
+pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution, condensation_s: Option<f64>, dir: &Path) -> Result<PointResult, String> {
     let t_post = Instant::now();
     let (mesh, layout) = (&setup.mesh, &setup.layout);
     let hertz = scene.hertz();
@@ -253,14 +253,14 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
             "dofs_elastic": n_u, "dofs_reynolds": n_p, "path": sol.steps, "half_domain": setup.half,
             "penalty": scene.reynolds.penalty, "stabilisation": scene.reynolds.stabilisation.as_str(),
         },
-        "timing": { "mesh_s": setup.mesh_s, "condensation_s": condensation_s, "assembly_s": sol.assembly_s, "solve_s": sol.solve_s, "post_s": t_post.elapsed().as_secs_f64(), "total_s": ctx.start.elapsed().as_secs_f64() },
+        "timing": { "mesh_s": setup.mesh_s, "assembly_s": sol.assembly_s, "solve_s": sol.solve_s, "post_s": t_post.elapsed().as_secs_f64(), "total_s": ctx.start.elapsed().as_secs_f64() },
         "peak_rss_mb": peak,
         "effects": effects_report(scene, setup.half),
         "scene": scene,
     });
-    if scene.effects.elasticity == crate::case::ElasticityModel::Rigid {
-        // No elastic block: no condensation phase.
-        summary["timing"].as_object_mut().unwrap().remove("condensation_s");
+    if let Some(c) = condensation_s {
+        // Only when the elastic block was condensed (not for rigid solids).
+        summary["timing"]["condensation_s"] = json!(c);
     }
     if let Some(f) = &friction {
         summary["friction"] = json!({ "model": scene.effects.friction.as_str(), "fx": f.fx, "fz": f.fz, "Fx_n": f.fx_n, "Fz_n": f.fz_n, "tau_max_pa": f.tau_max });

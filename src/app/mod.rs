@@ -52,6 +52,12 @@ impl Context {
         self.write_summary_to(&self.out_dir.clone(), summary)
     }
 
+    /// Creates the output subfolder `dir` (rank 0; the outcome is shared). Collective.
+    pub fn create_dir(&self, dir: &std::path::Path) -> Result<(), String> {
+        let made = if self.rank == 0 { std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display())) } else { Ok(()) };
+        collective::agree(&self.world, made)
+    }
+
     /// Writes summary.json into `dir` (atomically; see [`Context::write_summary`]).
     pub fn write_summary_to(&self, dir: &std::path::Path, summary: &serde_json::Value) -> Result<(), String> {
         let path = dir.join("summary.json");

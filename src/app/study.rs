@@ -82,15 +82,14 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize) -> Result<(), String> {
         ctx.log(format!("convergence study: level {} of {levels}, contact-zone size {h} a", k + 1));
         let t0 = Instant::now();
         let dir = ctx.out_dir.join(format!("level_{}", k + 1));
-        let made = if ctx.rank == 0 { std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display())) } else { Ok(()) };
-        collective::agree(&ctx.world, made)?;
+        ctx.create_dir(&dir)?;
         let setup = Setup::new(ctx, &sc)?;
         let solver = EhlSolver::new(ctx, &sc, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
         let (n_u, n_p) = setup.layout.counts();
         let solved = solver.solve(ctx, &sc, None).and_then(|sol| collective::agree(&ctx.world, post_point(ctx, &sc, &setup, &sol, solver.condensation_s, &dir)).map(|r| (sol, r)));
         let rss_mb = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
         let level = match solved {
-            Ok((sol, r)) => Level { failed: None, h, n_u, n_p, its: sol.newton_total, mesh_s: setup.mesh_s, condensation_s: solver.condensation_s, newton_s: sol.solve_s, total_s: t0.elapsed().as_secs_f64(), rss_mb, r },
+            Ok((sol, r)) => Level { failed: None, h, n_u, n_p, its: sol.newton_total, mesh_s: setup.mesh_s, condensation_s: solver.condensation_s.unwrap_or(0.0), newton_s: sol.solve_s, total_s: t0.elapsed().as_secs_f64(), rss_mb, r },
             Err(e) => {
                 // A level too coarse for the load fails honestly: recorded, skipped, the
                 // ladder goes on.
@@ -98,7 +97,7 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize) -> Result<(), String> {
                 if ctx.rank == 0 {
                     let _ = std::fs::remove_dir_all(&dir);
                 }
-                Level { failed: Some(e), h, n_u, n_p, its: 0, mesh_s: setup.mesh_s, condensation_s: solver.condensation_s, newton_s: 0.0, total_s: t0.elapsed().as_secs_f64(), rss_mb, r: PointResult::default() }
+                Level { failed: Some(e), h, n_u, n_p, its: 0, mesh_s: setup.mesh_s, condensation_s: solver.condensation_s.unwrap_or(0.0), newton_s: 0.0, total_s: t0.elapsed().as_secs_f64(), rss_mb, r: PointResult::default() }
             }
         };
         rows.push(level);

@@ -39,8 +39,7 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
         let t0 = Instant::now();
         ctx.log(format!("sweep point {} of {}: {}", k + 1, n, point_label(p)));
         let dir = ctx.out_dir.join(format!("point_{:03}", k + 1));
-        let made = if ctx.rank == 0 { std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display())) } else { Ok(()) };
-        collective::agree(&ctx.world, made)?;
+        ctx.create_dir(&dir)?;
         let mut its = 0;
         // Test hook (fault injection): EHL_FAIL_POINT=k makes point k fail as a
         // non-converged Newton would, to test that the sweep goes on and ends non-zero.
@@ -49,7 +48,7 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
         let result = match solved {
             Ok(sol) => {
                 its = sol.newton_total;
-                let r = collective::agree(&ctx.world, post_point(ctx, p, setup, &sol, if k == 0 { solver.condensation_s } else { 0.0 }, &dir));
+                let r = collective::agree(&ctx.world, post_point(ctx, p, setup, &sol, solver.condensation_s.map(|c| if k == 0 { c } else { 0.0 }), &dir));
                 if r.is_ok() {
                     prev = Some(sol.x);
                 }

@@ -170,7 +170,13 @@ impl<'a> CondensedSystem<'a> {
 
     /// The load integral of the pressure of x (dimensionless).
     pub fn load(&self, x: &[f64]) -> f64 {
-        self.elements.iter().map(|e| (0..6).map(|k| e.w[k] * Self::element_p(x, e)[k]).sum::<f64>()).sum()
+        self.elements
+            .iter()
+            .map(|e| {
+                let p = Self::element_p(x, e);
+                (0..6).map(|k| e.w[k] * p[k]).sum::<f64>()
+            })
+            .sum()
     }
 
     /// Local row of pressure unknown `d` if this rank owns it (None for -1 or another rank's).
@@ -230,7 +236,6 @@ impl<'a> CondensedSystem<'a> {
             for i in 0..6 {
                 let Some(l) = self.own_row(e.p[i]) else { continue };
                 cols[l].insert(np);
-                cols[l].insert(e.p[i] as usize);
                 for k in 0..6 {
                     if e.p[k] >= 0 {
                         cols[l].insert(e.p[k] as usize);
@@ -386,17 +391,9 @@ impl Problem for CondensedSystem<'_> {
         }
         if hi > self.layout.n_p {
             // Load balance, on the rank that owns H0.
-            let load: f64 = self
-                .elements
-                .iter()
-                .map(|e| {
-                    let p = Self::element_p(x, e);
-                    (0..6).map(|k| e.w[k] * p[k]).sum::<f64>()
-                })
-                .sum();
             r[self.layout.h0() - lo] = match self.fixed_h0 {
                 Some(h0) => x[self.layout.h0()] - h0,
-                None => load - self.params.load,
+                None => self.load(x) - self.params.load,
             };
         }
         if std::env::var_os("EHL_DEBUG").is_some() {

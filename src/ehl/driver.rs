@@ -150,10 +150,12 @@ pub struct EhlSolver<'a> {
     dofs: &'a DofMap,
     layout: &'a Layout,
     half: bool,
-    /// Face compliance (condensed path); None on the monolithic developer path.
+    /// Face compliance (condensed path; zero for rigid solids); None on the monolithic
+    /// developer path.
     comp: Option<crate::solid::condense::Compliance>,
-    /// Seconds spent building the compliance.
-    pub condensation_s: f64,
+    /// Seconds spent condensing the elastic block (None: no condensation phase, i.e.
+    /// rigid solids or the monolithic developer path).
+    pub condensation_s: Option<f64>,
 }
 
 impl<'a> EhlSolver<'a> {
@@ -169,15 +171,14 @@ impl<'a> EhlSolver<'a> {
         petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
         let t0 = std::time::Instant::now();
         let rigid = scene.effects.elasticity == crate::case::ElasticityModel::Rigid;
+        let p_nodes: Vec<u32> = mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect();
         let comp = if rigid {
-            let p_nodes: Vec<u32> = mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect();
             ctx.log(format!("rigid solids: no elastic unknowns, H = H0 + (X^2 + Z^2)/2; sparse Newton on {} pressure unknowns", p_nodes.len()));
             Some(crate::solid::condense::Compliance::rigid(mesh.contact_nodes.clone(), p_nodes))
         } else if monolithic {
             None
         } else {
             let eq = scene.equivalent_solid();
-            let p_nodes: Vec<u32> = mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect();
             let comp = crate::solid::condense::face_compliance(&ctx.world, mesh, eq.nu, assembly::traction_factor(eq.nu), &p_nodes).map_err(|e| e.to_string())?;
             ctx.log(format!(
                 "elastic block condensed onto the contact face: {} elastic unknowns -> {} face nodes x {} pressure nodes ({:.2} s)",
@@ -188,7 +189,8 @@ impl<'a> EhlSolver<'a> {
             ));
             Some(comp)
         };
-        Ok(EhlSolver { mesh, part, dofs, layout, half, comp, condensation_s: t0.elapsed().as_secs_f64() })
+        let condensation_s = (!rigid && !monolithic).then(|| t0.elapsed().as_secs_f64());
+        Ok(EhlSolver { mesh, part, dofs, layout, half, comp, condensation_s })
     }
 
     /// Solves the scene's operating point. `start`: a converged state of a neighbouring
@@ -256,7 +258,7 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
     let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);
-    ctx.log(format!("Newton from {label}: {} unknowns ({} P, 1 H0), dense Jacobian", cl.total(), cl.n_p));
+    ctx.log(format!("Newton from {label}: {} unknowns ({} P, 1 H0), {} Jacobian", cl.total(), cl.n_p, if comp.is_rigid() { "sparse" } else { "dense" }));
     let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.is_none(), &j, (lo, hi), cl.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.

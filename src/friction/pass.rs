@@ -63,34 +63,47 @@ fn in_rect(fields: &FieldsOnFace, t: usize, r: &Rect) -> bool {
     x > r.x0 && x < r.x1 && z > r.z0 && z < r.z1
 }
 
-/// The shear stress on the disc at barycentric point `b` of contact triangle `t` (Pa).
-fn stress_in_triangle(fields: &FieldsOnFace, s: &FrictionSetup, t: usize, b: [f64; 3]) -> Result<[f64; 2], String> {
-    let mesh = fields.mesh;
-    let tri = mesh.contact_tris[t];
-    let v: [[f64; 2]; 3] = std::array::from_fn(|i| {
-        let c = mesh.nodes[tri[i] as usize];
-        [c[0], c[2]]
-    });
-    let geo = AffineTri::new(&v);
-    let p = tri.map(|n| fields.p_node(n));
-    let h = tri.map(|n| fields.h_node(n));
-    let phi = p2_tri_basis_bary(b);
-    let dphi = p2_tri_grads_bary(b, &geo.grad_bary);
-    let (mut pv, mut hv, mut g) = (0.0, 0.0, [0.0; 2]);
-    for k in 0..6 {
-        pv += phi[k] * p[k];
-        hv += phi[k] * h[k];
-        g[0] += dphi[k][0] * p[k];
-        g[1] += dphi[k][1] * p[k];
+/// The data of one contact triangle the stress evaluation needs: vertices (units of a),
+/// barycentric gradients, nodal P and H. Built once per triangle.
+struct TriFields {
+    v: [[f64; 2]; 3],
+    geo: AffineTri,
+    p: [f64; 6],
+    h: [f64; 6],
+}
+
+impl TriFields {
+    fn new(fields: &FieldsOnFace, t: usize) -> Self {
+        let mesh = fields.mesh;
+        let tri = mesh.contact_tris[t];
+        let v: [[f64; 2]; 3] = std::array::from_fn(|i| {
+            let c = mesh.nodes[tri[i] as usize];
+            [c[0], c[2]]
+        });
+        TriFields { v, geo: AffineTri::new(&v), p: tri.map(|n| fields.p_node(n)), h: tri.map(|n| fields.h_node(n)) }
     }
-    let (x, z) = ((0..3).map(|i| b[i] * v[i][0]).sum::<f64>(), (0..3).map(|i| b[i] * v[i][1]).sum::<f64>());
-    let (xm, zm) = (x * s.a, z * s.a);
-    let vel = s.kinematics.at(xm, zm);
-    // The film's pressure is non-negative; the P2 interpolant's small undershoot at the
-    // cavitation boundary is not a physical tension: the viscosity sees max(p, 0).
-    let pa = pv.max(0.0) * s.ph;
-    let pt = FilmPoint { eta: (s.eta)(pa), h: hv * s.hs, grad_p: [g[0] * s.ph / s.a, g[1] * s.ph / s.a], slide: [vel.du(), vel.dw()] };
-    disc_shear_stress(&s.law, &pt).map_err(|e| format!("friction pass at (x, z) = ({x:.4}a, {z:.4}a): {e}"))
+
+    /// The shear stress on the disc at barycentric point `b` (Pa).
+    fn stress(&self, s: &FrictionSetup, b: [f64; 3]) -> Result<[f64; 2], String> {
+        let (v, p, h) = (&self.v, &self.p, &self.h);
+        let phi = p2_tri_basis_bary(b);
+        let dphi = p2_tri_grads_bary(b, &self.geo.grad_bary);
+        let (mut pv, mut hv, mut g) = (0.0, 0.0, [0.0; 2]);
+        for k in 0..6 {
+            pv += phi[k] * p[k];
+            hv += phi[k] * h[k];
+            g[0] += dphi[k][0] * p[k];
+            g[1] += dphi[k][1] * p[k];
+        }
+        let (x, z) = ((0..3).map(|i| b[i] * v[i][0]).sum::<f64>(), (0..3).map(|i| b[i] * v[i][1]).sum::<f64>());
+        let (xm, zm) = (x * s.a, z * s.a);
+        let vel = s.kinematics.at(xm, zm);
+        // The film's pressure is non-negative; the P2 interpolant's small undershoot at the
+        // cavitation boundary is not a physical tension: the viscosity sees max(p, 0).
+        let pa = pv.max(0.0) * s.ph;
+        let pt = FilmPoint { eta: (s.eta)(pa), h: hv * s.hs, grad_p: [g[0] * s.ph / s.a, g[1] * s.ph / s.a], slide: [vel.du(), vel.dw()] };
+        disc_shear_stress(&s.law, &pt).map_err(|e| format!("friction pass at (x, z) = ({x:.4}a, {z:.4}a): {e}"))
+    }
 }
 
 /// Runs the pass over Omega_c (serial; call it on one rank).
@@ -104,20 +117,16 @@ pub fn friction_pass(fields: &FieldsOnFace, s: &FrictionSetup) -> Result<Frictio
         if !in_rect(fields, t, &s.rect) {
             continue;
         }
-        let tri = mesh.contact_tris[t];
-        let v: [[f64; 2]; 3] = std::array::from_fn(|i| {
-            let c = mesh.nodes[tri[i] as usize];
-            [c[0], c[2]]
-        });
-        let area = crate::ehl::system::tri_area(&v) * s.a * s.a;
+        let tf = TriFields::new(fields, t);
+        let area = crate::ehl::system::tri_area(&tf.v) * s.a * s.a;
         for q in crate::reynolds::quadrature::DUNAVANT6.iter() {
-            let tau = stress_in_triangle(fields, s, t, q.l)?;
+            let tau = tf.stress(s, q.l)?;
             fx_n += q.w * area * tau[0];
             fz_n += q.w * area * tau[1];
         }
         let mut vals = [[0.0; 2]; 6];
         for (k, b) in NODES.iter().enumerate() {
-            vals[k] = stress_in_triangle(fields, s, t, *b)?;
+            vals[k] = tf.stress(s, *b)?;
             tau_max = tau_max.max(vals[k][0].hypot(vals[k][1]));
         }
         nodal.push((t, vals));
@@ -136,5 +145,5 @@ pub fn friction_pass(fields: &FieldsOnFace, s: &FrictionSetup) -> Result<Frictio
 pub fn stress_at(fields: &FieldsOnFace, s: &FrictionSetup, x: f64, z: f64) -> Option<Result<[f64; 2], String>> {
     let (t, b) = fields.locate(x, z)?;
     let mirrored = fields.half() && z > 0.0;
-    Some(stress_in_triangle(fields, s, t, b).map(|v| if mirrored { [v[0], -v[1]] } else { v }))
+    Some(TriFields::new(fields, t).stress(s, b).map(|v| if mirrored { [v[0], -v[1]] } else { v }))
 }

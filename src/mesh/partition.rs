@@ -48,10 +48,6 @@ fn sorted_by_key(keys: &[u64]) -> Vec<u32> {
     order
 }
 
-/// Splits the mesh into `nranks` parts: tets ordered along the Morton curve
-/// of their centroids and cut into contiguous chunks of equal size (within
-/// one); nodes owned by the lowest rank touching them. Pure function of the
-/// mesh, hence identical on every rank.
 /// All nodes of `mesh` in Morton order of their coordinates (ties by id).
 pub fn morton_order(mesh: &Mesh) -> Vec<u32> {
     let (lo, hi) = mesh.spec.bounds();
@@ -59,6 +55,10 @@ pub fn morton_order(mesh: &Mesh) -> Vec<u32> {
     sorted_by_key(&keys)
 }
 
+/// Splits the mesh into `nranks` parts: tets ordered along the Morton curve
+/// of their centroids and cut into contiguous chunks of equal size (within
+/// one); nodes owned by the lowest rank touching them. Pure function of the
+/// mesh, hence identical on every rank.
 pub fn partition(mesh: &Mesh, nranks: usize) -> Partition {
     assert!(nranks > 0, "partition: nranks must be > 0");
     let (lo, hi) = mesh.spec.bounds();
