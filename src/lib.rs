@@ -8,14 +8,18 @@
 //! - [`fem`]: quadrature, reference elements and element kernels (pure, PETSc-free).
 //! - [`petsc`]: FFI bindings and safe RAII wrappers; no physics.
 //! - [`output`]: summary.json and other result files.
+//! - [`interrupt`]: SIGINT/SIGTERM, stopping every rank together.
+//! - [`regress`]: summary.json comparison (regression runner) and the hard suite's checks.
 pub mod app;
 pub mod case;
 pub mod ehl;
 pub mod fem;
+pub mod interrupt;
 pub mod friction;
 pub mod mesh;
 pub mod output;
 pub mod petsc;
 pub mod physics;
+pub mod regress;
 pub mod solid;
 pub mod reynolds;

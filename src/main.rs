@@ -8,7 +8,9 @@ PETSc options follow the scene file and go to PETSc unchanged (PETSC_OPTIONS wor
   ehl-petsc cases/dry-hertz.toml -pc_type gamg -ksp_type cg -ksp_rtol 1e-10
 Defaults: -ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps -mat_mumps_icntl_7 4 (PORD).
 Useful: -log_view, -ksp_view, -options_left (lists options nobody used), -mat_mumps_icntl_4 2.
-Exit codes: 0 success, 1 solve failed or did not converge, 2 bad scene or output folder, 3 PETSc start-up.";
+Exit codes: 0 success, 1 solve failed or did not converge, 2 bad scene or output folder, 3 PETSc start-up,
+  130/143 interrupted by SIGINT/SIGTERM (all ranks stop at the next check; no result of the
+  interrupted solve is written).";
 
 /// Full-system FEM solver for elastohydrodynamic lubrication (EHL) of circular contacts
 /// under rolling, sliding and spinning, on PETSc and MPI.
@@ -24,6 +26,10 @@ struct Cli {
     /// Output folder (default: the scene's output.dir)
     #[arg(long, value_name = "DIR")]
     output: Option<PathBuf>,
+    /// Override a scene key before validation, e.g. --set mesh.core_size=0.0625
+    /// --set operating.load=2000 (repeatable; the value is TOML, bare words are strings)
+    #[arg(long = "set", value_name = "KEY=VALUE", action = ArgAction::Append)]
+    set: Vec<String>,
     /// Validate the scene file and exit without solving
     #[arg(long)]
     check: bool,
@@ -71,6 +77,7 @@ fn main() {
         check_only: cli.check,
         quiet: cli.quiet,
         study_levels: cli.convergence_study,
+        overrides: cli.set,
     };
     let code = ehl_petsc::app::run(world, opts);
     drop(universe);

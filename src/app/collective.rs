@@ -17,6 +17,13 @@ pub fn agree<T>(world: &SimpleCommunicator, local: Result<T, String>) -> Result<
     }
 }
 
+/// Whether `flag` holds on every rank.
+pub fn all(world: &SimpleCommunicator, flag: bool) -> bool {
+    let mut out: i32 = 0;
+    world.all_reduce_into(&(flag as i32), &mut out, SystemOperation::min());
+    out == 1
+}
+
 /// The maximum of a value over all ranks.
 pub fn max_f64(world: &SimpleCommunicator, v: f64) -> f64 {
     let mut out = 0.0;

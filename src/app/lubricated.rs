@@ -155,6 +155,14 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
     let st = fields.stats();
     let target = if setup.half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 };
     let load_error = (st.load - target).abs() / target;
+    // A converged Newton can still hold an unphysical state: never report it as a result.
+    // Every rank holds the whole iterate, so every rank reaches the same verdict.
+    if sol.x.iter().any(|v| !v.is_finite()) || ![st.hc, st.hm, st.pmax, st.pmin, st.load].iter().all(|v| v.is_finite()) {
+        return Err("the converged state contains NaN or infinite values; no result written".into());
+    }
+    if st.hm <= 0.0 {
+        return Err(format!("the converged film is not positive everywhere (minimum H = {:.3e} at ({:.3}a, {:.3}a)); no result written", st.hm, st.hm_at[0], st.hm_at[1]));
+    }
     let hs = scene.scales().film_scale();
     let (a, ph) = (hertz.a, hertz.ph);
     ctx.log(format!(
@@ -246,7 +254,8 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
             "hc_hamrock_dowson_m": hd.map(|h| h.central_film_thickness()),
             "hm_hamrock_dowson_m": hd.map(|h| h.minimum_film_thickness()),
         },
-        "pressure": { "pmax_pa": st.pmax * ph, "pmax_x_m": st.pmax_at[0] * a, "pmax_z_m": st.pmax_at[1] * a, "pmin_pa": st.pmin * ph, "load_error_rel": load_error },
+        "pressure": { "pmax_pa": st.pmax * ph, "pmax_x_m": st.pmax_at[0] * a, "pmax_z_m": st.pmax_at[1] * a, "pmin_pa": st.pmin * ph, "pmin_nodes_pa": st.pmin_nodes * ph, "load_error_rel": load_error },
+        "moes": scene.moes().map(|m| json!({ "M": m.m, "L": m.l })),
         "solver": {
             "newton_iterations": sol.newton_total, "snes_reason": sol.report.reason,
             "residual_norm": sol.report.residual_norm,

@@ -24,6 +24,8 @@ pub struct RunOptions {
     pub quiet: bool,
     /// `--convergence-study N`: solve the scene on N meshes (see [`study`]).
     pub study_levels: Option<usize>,
+    /// `--set KEY=VALUE` scene overrides, applied before validation.
+    pub overrides: Vec<String>,
 }
 
 /// Shared state of one run on one rank.
@@ -75,7 +77,7 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     let size = world.size() as usize;
     let start = Instant::now();
     // The scene is read and validated on every rank: the outcome is the same everywhere.
-    let scene = match crate::case::load_scene(&opts.scene) {
+    let scene = match crate::case::load_scene_with(&opts.scene, &opts.overrides) {
         Ok(s) => s,
         Err(e) => {
             if rank == 0 {
@@ -108,6 +110,7 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             return 3;
         }
     };
+    crate::interrupt::install();
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {
@@ -115,11 +118,20 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
         Some(_) => Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into()),
         None => simulate(&ctx, &scene),
     };
+    let failed_here = result.is_err();
     let code = match collective::agree(&ctx.world, result) {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("ehl-petsc: error (rank {rank}): {e}");
-            1
+            // A failure every rank shares (Newton, an interruption) is printed once, by
+            // rank 0; a rank that failed alone prints its own message.
+            let all_failed = collective::all(&ctx.world, failed_here);
+            if rank == 0 || (failed_here && !all_failed) {
+                eprintln!("ehl-petsc: error{}: {e}", if all_failed { String::new() } else { format!(" (rank {rank})") });
+            }
+            match crate::interrupt::agreed() {
+                0 => 1,
+                sig => 128 + sig,
+            }
         }
     };
     drop(petsc);

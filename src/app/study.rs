@@ -97,6 +97,9 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize) -> Result<(), String> {
                 if ctx.rank == 0 {
                     let _ = std::fs::remove_dir_all(&dir);
                 }
+                if crate::interrupt::agreed() != 0 {
+                    return Err(e);
+                }
                 Level { failed: Some(e), h, n_u, n_p, its: 0, mesh_s: setup.mesh_s, condensation_s: solver.condensation_s.unwrap_or(0.0), newton_s: 0.0, total_s: t0.elapsed().as_secs_f64(), rss_mb, r: PointResult::default() }
             }
         };

@@ -65,6 +65,10 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
                     // Only converged points keep a folder: no partial output.
                     let _ = std::fs::remove_dir_all(&dir);
                 }
+                if crate::interrupt::agreed() != 0 {
+                    // Interrupted: the completed points keep their folders and sweep.csv.
+                    return Err(e.clone());
+                }
             }
         }
         rows.push(SweepRow { ue: p.operating.entrainment_speed.unwrap_or(f64::NAN), lambda_deg: p.operating.tilt_angle, srr: p.operating.slide_to_roll, result, newton_iterations: its, wall_s });

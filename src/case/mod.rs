@@ -36,9 +36,16 @@ use spec::fmt_num;
 /// or to the parent directory's name when the file is called `case.toml` or `scene.toml`.
 /// Every error names the file.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    load_scene_with(path, &[])
+}
+
+/// As [`load_scene`], with command-line overrides `KEY=VALUE` (dotted key, TOML value; a
+/// value that is not valid TOML is taken as a string) applied before validation, so an
+/// override is checked like the file's own keys.
+pub fn load_scene_with(path: &Path, overrides: &[String]) -> Result<Scene, SceneError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| SceneError::new(SceneErrorKind::Io(e)).in_file(path.to_path_buf()))?;
-    parse_scene(&text, &default_name(path)).map_err(|e| e.in_file(path.to_path_buf()))
+    parse_scene_with(&text, &default_name(path), overrides).map_err(|e| e.in_file(path.to_path_buf()))
 }
 
 fn default_name(path: &Path) -> String {
@@ -57,8 +64,16 @@ fn default_name(path: &Path) -> String {
 
 /// Parses and validates scene text; `default_name` is used when the text has no `name`.
 pub fn parse_scene(text: &str, default_name: &str) -> Result<Scene, SceneError> {
-    let table: toml::Table =
+    parse_scene_with(text, default_name, &[])
+}
+
+/// As [`parse_scene`], with `KEY=VALUE` overrides (see [`load_scene_with`]).
+pub fn parse_scene_with(text: &str, default_name: &str, overrides: &[String]) -> Result<Scene, SceneError> {
+    let mut table: toml::Table =
         toml::from_str(text).map_err(|e| SceneErrorKind::Syntax(syntax_message(text, &e)))?;
+    for o in overrides {
+        apply_override(&mut table, o)?;
+    }
     spec::check_table(SCENE_FIELDS, &table, SCENE_FIELDS, "")?;
     let mut scene = Scene::deserialize(toml::Value::Table(table))
         .map_err(|e| SceneErrorKind::Syntax(format!("scene does not match the schema: {e}")))?;
@@ -77,6 +92,28 @@ pub fn parse_scene(text: &str, default_name: &str) -> Result<Scene, SceneError> 
     }
     scene.validate()?;
     Ok(scene)
+}
+
+/// Sets the dotted key of `KEY=VALUE` in `table` (creating missing sections).
+fn apply_override(table: &mut toml::Table, o: &str) -> Result<(), SceneError> {
+    let bad = |why: &str| SceneError::from(SceneErrorKind::Syntax(format!("--set {o}: {why}")));
+    let (key, value) = o.split_once('=').ok_or_else(|| bad("expected KEY=VALUE, e.g. mesh.core_size=0.0625"))?;
+    let (key, value) = (key.trim(), value.trim());
+    let parts: Vec<&str> = key.split('.').collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err(bad("the key must be dotted names, e.g. operating.load"));
+    }
+    let value = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
+        Ok(mut t) => t.remove("v").expect("parsed above"),
+        Err(_) => toml::Value::String(value.to_string()),
+    };
+    let mut t = table;
+    for (i, p) in parts[..parts.len() - 1].iter().enumerate() {
+        let entry = t.entry(p.to_string()).or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        t = entry.as_table_mut().ok_or_else(|| bad(&format!("'{}' is not a section", parts[..=i].join("."))))?;
+    }
+    t.insert(parts[parts.len() - 1].to_string(), value);
+    Ok(())
 }
 
 /// One-line TOML syntax message: `line L, column C: what`.

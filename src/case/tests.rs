@@ -633,3 +633,22 @@ fn bad_sweep_lists_name_the_element() {
     let e = parse_scene(&uniform, "x").unwrap_err().to_string();
     assert!(e.contains("sweep.tilt_angle") && e.contains("uniform"), "{e}");
 }
+
+#[test]
+fn command_line_overrides_are_validated_like_the_file() {
+    let set = |o: &[&str]| parse_scene_with(PAPER_SPIN, "x", &o.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+    // A number, a bare word (string), a new section key.
+    let s = set(&["operating.load=2000", "effects.friction=none", "mesh.core_size=0.0625"]).unwrap();
+    assert_eq!(s.operating.load, 2000.0);
+    assert_eq!(s.effects.friction, FrictionModel::Off);
+    assert_eq!(s.mesh.core_size, 0.0625);
+    // Out of range, unknown key, not KEY=VALUE, a value where a section is.
+    let e = set(&["operating.load=-1"]).unwrap_err().to_string();
+    assert!(e.contains("operating.load") && e.contains("-1"), "{e}");
+    let e = set(&["operating.lod=1"]).unwrap_err().to_string();
+    assert!(e.contains("operating.lod") && e.contains("load"), "{e}");
+    let e = set(&["operating.load"]).unwrap_err().to_string();
+    assert!(e.contains("--set operating.load") && e.contains("KEY=VALUE"), "{e}");
+    let e = set(&["name.x=1"]).unwrap_err().to_string();
+    assert!(e.contains("'name' is not a section"), "{e}");
+}

@@ -363,7 +363,8 @@ impl Problem for CondensedSystem<'_> {
         // Every rank holds the same iterate and the same compliance: the domain check
         // agrees everywhere without communication.
         if let Some(k) = h.iter().position(|v| !(*v > 0.0) || !v.is_finite()) {
-            return Ok(Eval::Domain(format!("film thickness H = {:.3e} at face node {}", h[k], self.comp.rows[k])));
+            let at = self.debug_mesh.map(|m| m.nodes[self.comp.rows[k] as usize]).map(|c| format!(" (X, Z) = ({:.3}, {:.3})", c[0], c[2])).unwrap_or_default();
+            return Ok(Eval::Domain(format!("film thickness H = {:.3e} at face node {}{at}", h[k], self.comp.rows[k])));
         }
         let (lo, hi) = self.owned();
         let mut r = vec![0.0; hi - lo];

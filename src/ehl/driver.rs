@@ -167,6 +167,8 @@ impl<'a> EhlSolver<'a> {
         if !monolithic {
             // The condensed Jacobian is dense: MUMPS's PORD ordering rejects it, AMD is fine.
             petsc::options::set_default("-mat_mumps_icntl_7", "0").map_err(|e| e.to_string())?;
+            // The condensation's 3D Cholesky has its own prefix and keeps PORD.
+            petsc::options::set_default("-elastic_mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
         }
         petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
         let t0 = std::time::Instant::now();
@@ -190,6 +192,7 @@ impl<'a> EhlSolver<'a> {
             Some(comp)
         };
         let condensation_s = (!rigid && !monolithic).then(|| t0.elapsed().as_secs_f64());
+        crate::interrupt::check("the elastic condensation")?;
         Ok(EhlSolver { mesh, part, dofs, layout, half, comp, condensation_s })
     }
 
@@ -203,6 +206,7 @@ impl<'a> EhlSolver<'a> {
                 if let Some(prev) = start {
                     match solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, Some(prev)) {
                         Ok(s) => return Ok(s),
+                        Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
                         Err(e) => ctx.log(format!("Newton from the previous operating point failed ({e}); starting over from the Hertz start")),
                     }
                 }
@@ -403,8 +407,20 @@ struct NewtonOutcome {
     steps: Vec<String>,
 }
 
+/// A continuation parameter t in (0, 1]: `apply` sets the scene's problem at t (t = 1: the
+/// scene itself; smaller t: milder).
+struct Homotopy {
+    name: &'static str,
+    /// First t tried from the start, halved down to `lowest` until Newton converges.
+    start: f64,
+    lowest: f64,
+    apply: Box<dyn Fn(&mut Scene, f64)>,
+    show: Box<dyn Fn(f64) -> String>,
+}
+
 /// Newton from `x0` (described by `label`) at the scene's operating point; if that fails
-/// and `continuation` is set, a continuation in load from a light load up to the scene's.
+/// and `continuation` is set, a continuation in pressure-viscosity, then in load, then in
+/// speed, from a milder problem to the scene's (each step is logged and kept in the path).
 /// Returns the converged iterate (gathered) or an error naming the path taken.
 #[allow(clippy::too_many_arguments)]
 fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], label: &str, continuation: bool, j: &Matrix, (lo, hi): (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
@@ -413,10 +429,8 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     let x = Vector::new(comm, local).map_err(pe)?;
     let snes = Snes::new(comm, "").map_err(pe)?;
     let scaling = std::env::var_os("EHL_NO_ROW_SCALING").is_none();
-    let solve_at = |load: f64, system: &mut dyn EhlProblem, start: &[f64]| -> Result<SolveReport, String> {
-        let mut sc = scene.clone();
-        sc.operating.load = load;
-        system.set_operating(lambda_bar(&sc), lubricant(&sc));
+    let solve_scene = |sc: &Scene, system: &mut dyn EhlProblem, start: &[f64]| -> Result<SolveReport, String> {
+        system.set_operating(lambda_bar(sc), lubricant(sc));
         x.set_local_values(&start[lo..hi]).map_err(pe)?;
         if scaling {
             system.scale_rows(start).map_err(pe)?;
@@ -428,7 +442,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     let report = if std::env::var_os("EHL_SKIP_PLAIN").is_some() {
         SolveReport { converged: false, reason: "SKIPPED".into(), reason_code: 0, iterations: 0, linear_iterations: 0, residual_norm: f64::NAN, domain_error: None }
     } else {
-        solve_at(target, system, x0)?
+        solve_scene(scene, system, x0)?
     };
     let mut steps = vec![format!("Newton from {label} at L = {} N: {} ({} iterations)", target, report.reason, report.iterations)];
     ctx.log(&steps[0]);
@@ -490,50 +504,91 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
             newton_total += its;
             steps.push(format!("pseudo-transient continuation: {n_steps} pseudo-time steps ({its} iterations), steady residual {:.2e} of the start's{}", fk / f_start, if ok { "" } else { " (gave up)" }));
             ctx.log(steps.last().unwrap());
-            let r = solve_at(target, system, &xk)?;
+            let r = solve_scene(scene, system, &xk)?;
             newton_total += r.iterations;
             steps.push(format!("Newton on the steady problem: {} ({} iterations)", r.reason, r.iterations));
             ctx.log(steps.last().unwrap());
             last = r;
         }
     }
-    // 3. If it failed: continuation in load. A lighter load is a milder problem in Hertz
-    //    units (smaller M, alpha p_H); each converged state starts the next, heavier one.
+    // 3. If it failed: continuation, first in pressure-viscosity, then in load, then in
+    //    speed. Each is a milder problem at one end (a smaller alpha: a less steep
+    //    viscosity at the same Hertz geometry, so the Hertz start stays good; a lighter
+    //    load in Hertz units: smaller M and alpha p_H; a higher speed: a thicker film) and
+    //    the scene's at the other; each converged state starts the next. Pressure-viscosity
+    //    goes first: on the hard suite it is the one that converges (alpha30 on the paper
+    //    mesh: load continuation fails from every Hertz start down to L/64, alpha/2 -> alpha
+    //    converges in 23 + 8 iterations).
     if !last.converged && continuation {
-        let mut load = target / 8.0;
-        let mut state: Option<Vec<f64>> = None;
-        while load >= target / 64.0 {
-            let r = solve_at(load, system, x0)?;
-            newton_total += r.iterations;
-            steps.push(format!("continuation: Hertz start at L = {load:.4} N: {} ({} iterations)", r.reason, r.iterations));
-            ctx.log(steps.last().unwrap());
-            if r.converged {
-                state = Some(x.gather_all().map_err(pe)?);
-                break;
+        let alpha = scene.lubricant.as_ref().and_then(|l| l.pressure_viscosity).unwrap_or(0.0);
+        let z = scene.lubricant.as_ref().and_then(|l| l.roelands_exponent);
+        let ue = scene.operating.entrainment_speed.unwrap_or(0.0);
+        let homotopies: Vec<Homotopy> = vec![
+            Homotopy {
+                name: "pressure-viscosity",
+                start: 0.5,
+                lowest: 0.125,
+                apply: Box::new(move |sc: &mut Scene, t| {
+                    if let Some(l) = sc.lubricant.as_mut() {
+                        l.pressure_viscosity = l.pressure_viscosity.map(|_| alpha * t);
+                        l.roelands_exponent = z.map(|z| z * t);
+                    }
+                }),
+                show: Box::new(move |t| format!("alpha = {:.4} GPa^-1", alpha * t * 1e9)),
+            },
+            Homotopy { name: "load", start: 1.0 / 8.0, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.load = target * t), show: Box::new(move |t| format!("L = {:.4} N", target * t)) },
+            Homotopy { name: "speed", start: 0.25, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.entrainment_speed = Some(ue / t)), show: Box::new(move |t| format!("Ue = {:.4} m/s", ue / t)) },
+        ];
+        for h in &homotopies {
+            if h.name == "pressure-viscosity" && alpha == 0.0 {
+                continue;
             }
-            load /= 2.0;
-        }
-        let Some(mut state) = state else {
-            return Err(format!("Newton did not converge, not even with load continuation down to L = {:.4} N; steps: {}", target / 64.0, steps.join("; ")));
-        };
-        // Ramp the load up to the target, halving the step ratio on failure.
-        let mut ratio: f64 = 2.0;
-        while load < target {
-            let next = (load * ratio).min(target);
-            let r = solve_at(next, system, &state)?;
-            newton_total += r.iterations;
-            steps.push(format!("continuation: L = {next:.4} N: {} ({} iterations)", r.reason, r.iterations));
-            ctx.log(steps.last().unwrap());
-            if r.converged {
-                state = x.gather_all().map_err(pe)?;
-                load = next;
-                last = r;
-            } else {
-                ratio = ratio.sqrt();
-                if ratio < 1.05 {
-                    last = r;
+            let solve_h = |t: f64, system: &mut dyn EhlProblem, start: &[f64]| {
+                let mut sc = scene.clone();
+                (h.apply)(&mut sc, t);
+                solve_scene(&sc, system, start)
+            };
+            // Find a milder problem Newton solves from the start.
+            let mut t = h.start;
+            let mut state: Option<Vec<f64>> = None;
+            while t >= h.lowest {
+                crate::interrupt::check("the continuation")?;
+                let r = solve_h(t, system, x0)?;
+                newton_total += r.iterations;
+                steps.push(format!("{} continuation: {label} at {}: {} ({} iterations)", h.name, (h.show)(t), r.reason, r.iterations));
+                ctx.log(steps.last().unwrap());
+                if r.converged {
+                    state = Some(x.gather_all().map_err(pe)?);
                     break;
                 }
+                t /= 2.0;
+            }
+            let Some(mut state) = state else {
+                steps.push(format!("{} continuation: no milder problem converged down to {}", h.name, (h.show)(h.lowest)));
+                continue;
+            };
+            // Ramp to the scene's problem (t = 1), halving the step ratio on failure.
+            let mut ratio: f64 = 2.0;
+            while t < 1.0 {
+                let next = (t * ratio).min(1.0);
+                let r = solve_h(next, system, &state)?;
+                newton_total += r.iterations;
+                steps.push(format!("{} continuation: {}: {} ({} iterations)", h.name, (h.show)(next), r.reason, r.iterations));
+                ctx.log(steps.last().unwrap());
+                if r.converged {
+                    state = x.gather_all().map_err(pe)?;
+                    t = next;
+                    last = r;
+                } else {
+                    ratio = ratio.sqrt();
+                    if ratio < 1.05 {
+                        last = r;
+                        break;
+                    }
+                }
+            }
+            if t >= 1.0 && last.converged {
+                break;
             }
         }
     }

@@ -22,7 +22,11 @@ pub struct FilmStats {
     pub pmax_at: [f64; 2],
     pub load: f64,
     pub h0: f64,
+    /// Minimum of the P2 pressure field (lattice search; the interpolant can undershoot
+    /// the nodal values next to a steep pressure spike).
     pub pmin: f64,
+    /// Minimum nodal pressure (the unknowns: what the cavitation penalty acts on).
+    pub pmin_nodes: f64,
 }
 
 impl<'a> FieldsOnFace<'a> {
@@ -96,7 +100,8 @@ impl<'a> FieldsOnFace<'a> {
             }
         }
         let hc = self.at(0.0, 0.0).map(|v| v.1).unwrap_or(f64::NAN);
-        FilmStats { hc, hm, hm_at, pmax, pmax_at, load, h0: self.x[self.layout.h0 as usize], pmin }
+        let pmin_nodes = self.mesh.contact_nodes.iter().map(|&n| self.p_node(n)).fold(f64::INFINITY, f64::min);
+        FilmStats { hc, hm, hm_at, pmax, pmax_at, load, h0: self.x[self.layout.h0 as usize], pmin, pmin_nodes }
     }
 
     /// Samples (X, Z, P, H) on the segment from `a` to `b` with `n` points.

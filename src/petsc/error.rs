@@ -15,7 +15,12 @@ pub struct PetscError {
 
 impl std::fmt::Display for PetscError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "PETSc error {}: {}", self.code, self.message)
+        if self.code == 0 {
+            // Raised by the Rust layer (e.g. an interruption): its own message says it all.
+            write!(f, "{}", self.message)
+        } else {
+            write!(f, "PETSc error {}: {}", self.code, self.message)
+        }
     }
 }
 impl std::error::Error for PetscError {}

@@ -59,6 +59,12 @@ pub struct Snes {
 
 unsafe extern "C" fn form_function(snes: ffi::SNES, x: ffi::Vec, f: ffi::Vec, ctx: *mut c_void) -> ffi::PetscErrorCode {
     let ctx = &mut *(ctx as *mut Context);
+    // Every rank evaluates the residual together: the place to stop on SIGINT/SIGTERM.
+    let sig = crate::interrupt::collective_signal();
+    if sig != 0 {
+        ctx.error = Some(rust_error(&crate::interrupt::message(sig, "the Newton solve")));
+        return ffi::PETSC_ERR_LIB as ffi::PetscErrorCode;
+    }
     let run = || -> Result<Eval> {
         let xv = std::mem::ManuallyDrop::new(Vector { raw: x });
         let fv = std::mem::ManuallyDrop::new(Vector { raw: f });

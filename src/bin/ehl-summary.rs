@@ -1,0 +1,112 @@
+//! `ehl-summary`: reads ehl-petsc's summary.json files for the regression runner
+//! (`ci/regress`) and the hard suite (`ci/hard`).
+//!
+//!   ehl-summary compare REF.json NEW.json [--tolerances FILE] [--rel TOL]
+//!       prints a table of the keys that moved; exit 1 on drift (or a missing key)
+//!   ehl-summary get FILE.json KEY...        prints the values of dotted keys
+//!   ehl-summary hard OUTDIR CASE...         the hard suite's table (OUTDIR/hard.md); exit 1 on a failed check
+use clap::{Parser, Subcommand};
+use ehl_petsc::regress::{self, hard, Tolerances};
+use std::path::{Path, PathBuf};
+
+#[derive(Parser)]
+#[command(name = "ehl-summary", about = "Compare and check ehl-petsc summary.json files")]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Compare NEW with the reference REF key by key; exit 1 if a key drifted or is missing
+    Compare {
+        reference: PathBuf,
+        new: PathBuf,
+        /// Per-key tolerances (TOML: default = REL, [keys] "pattern" = REL | "ignore" | { rel, abs })
+        #[arg(long)]
+        tolerances: Option<PathBuf>,
+        /// Replace every relative tolerance by REL (ignored keys and absolute floors stay)
+        #[arg(long)]
+        rel: Option<f64>,
+        /// Label printed in the verdict line
+        #[arg(long, default_value = "")]
+        label: String,
+    },
+    /// Print the values of dotted keys (e.g. film.hc_m)
+    Get { file: PathBuf, keys: Vec<String> },
+    /// The hard suite's table from OUTDIR/CASE/{default,refined}/summary.json (and .wall, .log)
+    Hard { outdir: PathBuf, cases: Vec<String> },
+}
+
+fn read_json(p: &Path) -> Result<serde_json::Value, String> {
+    let text = std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?;
+    serde_json::from_str(&text).map_err(|e| format!("{} is not valid JSON: {e}", p.display()))
+}
+
+fn run(cli: Cli) -> Result<i32, String> {
+    match cli.cmd {
+        Cmd::Compare { reference, new, tolerances, rel, label } => {
+            let mut tol = match &tolerances {
+                Some(p) => Tolerances::parse(&std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?).map_err(|e| format!("{}: {e}", p.display()))?,
+                None => Tolerances::uniform(1e-6),
+            };
+            if let Some(r) = rel {
+                tol = tol.with_rel(r);
+            }
+            let c = regress::compare(&read_json(&reference)?, &read_json(&new)?, &tol);
+            print!("{}", c.table());
+            let verdict = if c.failures() == 0 { "PASS" } else { "DRIFT" };
+            println!("{verdict}{}: {} against {}", if label.is_empty() { String::new() } else { format!(" {label}") }, new.display(), reference.display());
+            Ok(if c.failures() == 0 { 0 } else { 1 })
+        }
+        Cmd::Get { file, keys } => {
+            let flat = regress::flatten(&read_json(&file)?);
+            for k in keys {
+                match flat.get(&k) {
+                    Some(regress::Leaf::Num(v)) => println!("{v:e}"),
+                    Some(regress::Leaf::Text(s)) => println!("{s}"),
+                    Some(v) => println!("{v}"),
+                    None => return Err(format!("{}: no key '{k}'", file.display())),
+                }
+            }
+            Ok(0)
+        }
+        Cmd::Hard { outdir, cases } => {
+            let load = |case: &str, mesh: &str| -> hard::Run {
+                let base = outdir.join(case).join(mesh);
+                let wall_s = std::fs::read_to_string(base.with_extension("wall")).ok().and_then(|t| t.trim().parse().ok()).unwrap_or(f64::NAN);
+                match read_json(&base.join("summary.json")) {
+                    Ok(s) => hard::Run { summary: Some(s), wall_s, error: None },
+                    Err(_) => {
+                        // The reason is the run's error line.
+                        let log = std::fs::read_to_string(base.with_extension("log")).unwrap_or_default();
+                        let reason = log.lines().find(|l| l.starts_with("ehl-petsc: error")).map(|l| l.trim_start_matches("ehl-petsc: error: ").to_string()).unwrap_or_else(|| "no summary.json and no error line".into());
+                        hard::Run { summary: None, wall_s, error: Some(reason) }
+                    }
+                }
+            };
+            let mut md = String::from(hard::HEADER);
+            let mut n_failed = 0;
+            for case in &cases {
+                let (row, failed) = hard::check_case(case, &load(case, "default"), &load(case, "refined"));
+                md.push_str(&row);
+                n_failed += usize::from(!failed.is_empty());
+            }
+            md.push_str(&format!("\n{} of {} cases pass every check.\n", cases.len() - n_failed, cases.len()));
+            print!("{md}");
+            let path = outdir.join("hard.md");
+            std::fs::write(&path, &md).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            Ok(if n_failed == 0 { 0 } else { 1 })
+        }
+    }
+}
+
+fn main() {
+    match run(Cli::parse()) {
+        Ok(code) => std::process::exit(code),
+        Err(e) => {
+            eprintln!("ehl-summary: error: {e}");
+            std::process::exit(2);
+        }
+    }
+}

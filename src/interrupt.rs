@@ -1,0 +1,90 @@
+//! SIGINT and SIGTERM: a run stops on every rank at the next check, with a clear message,
+//! and writes no result of the interrupted solve.
+//!
+//! The signal handler only stores the signal number (async-signal-safe). The solve checks
+//! it at points every rank reaches together (each Newton residual evaluation, after the
+//! elastic condensation, before each sweep point and study level) through an MPI
+//! reduction, so a signal that reaches one rank only (a batch system killing one task)
+//! stops all of them at the same point instead of leaving the others waiting in a
+//! collective call. Results are written only after a converged solve, each file through a
+//! temporary name and a rename ([`crate::output::write_atomic`]): an interrupted run leaves
+//! the files of earlier runs (or of the sweep points it completed) and nothing half-written.
+//!
+//! Installed after `PetscInitialize`, so it replaces PETSc's own handler for these two
+//! signals (which would abort without cleaning up). Exit code 128 + signal number.
+use std::sync::atomic::{AtomicI32, Ordering};
+
+/// The signal this process received (0: none).
+static LOCAL: AtomicI32 = AtomicI32::new(0);
+/// The signal every rank agreed on at the last collective check (0: none).
+static AGREED: AtomicI32 = AtomicI32::new(0);
+
+extern "C" fn on_signal(sig: libc::c_int) {
+    LOCAL.store(sig, Ordering::SeqCst);
+}
+
+/// Installs the handler for SIGINT and SIGTERM.
+pub fn install() {
+    for sig in [libc::SIGINT, libc::SIGTERM] {
+        // SAFETY: a zeroed sigaction with a plain handler is valid; the handler only does an
+        // atomic store.
+        unsafe {
+            let mut act: libc::sigaction = std::mem::zeroed();
+            act.sa_sigaction = on_signal as extern "C" fn(libc::c_int) as usize;
+            act.sa_flags = libc::SA_RESTART;
+            libc::sigemptyset(&mut act.sa_mask);
+            libc::sigaction(sig, &act, std::ptr::null_mut());
+        }
+    }
+}
+
+/// Name of a signal for messages.
+pub fn signal_name(sig: i32) -> String {
+    match sig {
+        libc::SIGINT => "SIGINT".into(),
+        libc::SIGTERM => "SIGTERM".into(),
+        s => format!("signal {s}"),
+    }
+}
+
+/// The message of an interrupted run.
+pub fn message(sig: i32, during: &str) -> String {
+    format!("interrupted by {} during {during}; stopped on every rank, no result of this solve was written", signal_name(sig))
+}
+
+/// Collective over PETSC_COMM_WORLD: the largest signal number any rank received (0 if
+/// none). Every rank must call it at the same point.
+pub fn collective_signal() -> i32 {
+    let local = LOCAL.load(Ordering::SeqCst);
+    let mut all: i32 = 0;
+    // SAFETY: plain MPI reduction of one int over the world communicator, which PETSc and
+    // every rank share; called collectively.
+    unsafe {
+        mpi::ffi::MPI_Allreduce(
+            &local as *const i32 as *const std::ffi::c_void,
+            &mut all as *mut i32 as *mut std::ffi::c_void,
+            1,
+            mpi::ffi::RSMPI_INT32_T,
+            mpi::ffi::RSMPI_MAX,
+            crate::petsc::comm_world(),
+        );
+    }
+    if all != 0 {
+        AGREED.store(all, Ordering::SeqCst);
+    }
+    all
+}
+
+/// Collective check: `Err` with a clear message when any rank received a signal.
+pub fn check(during: &str) -> Result<(), String> {
+    match collective_signal() {
+        0 => Ok(()),
+        sig => Err(message(sig, during)),
+    }
+}
+
+/// The signal agreed at a collective check (0: none); local, no communication. Used to
+/// stop retries and fall-backs after an interruption and to choose the exit code.
+pub fn agreed() -> i32 {
+    AGREED.load(Ordering::SeqCst)
+}

@@ -1,0 +1,202 @@
+//! The hard suite's checks (issue 7): each case solved on its default mesh and on one
+//! refinement must converge with no NaN, nodal p >= -1e-3 p_H (after the cavitation
+//! penalty), h > 0 everywhere, load error below 1e-6, and hc, hm moving less than 2 %
+//! between the two meshes.
+use super::{flatten, Leaf};
+use serde_json::Value;
+
+/// Most negative nodal pressure allowed, in units of p_H.
+pub const PMIN_OVER_PH: f64 = -1e-3;
+/// Largest load-balance error allowed.
+pub const LOAD_ERROR: f64 = 1e-6;
+/// Largest change of hc and hm between the two meshes (relative to the refined mesh).
+pub const MESH_CHANGE: f64 = 0.02;
+
+/// One run of a case: its summary (None if it failed), wall time and failure message.
+#[derive(Debug, Clone, Default)]
+pub struct Run {
+    pub summary: Option<Value>,
+    pub wall_s: f64,
+    pub error: Option<String>,
+}
+
+fn num(s: &Value, path: &str) -> Option<f64> {
+    let mut v = s;
+    for p in path.split('.') {
+        v = v.get(p)?;
+    }
+    v.as_f64()
+}
+
+/// Numbers the checks and the table need from one converged run.
+#[derive(Debug, Clone, Copy)]
+struct Key {
+    hc: f64,
+    hm: f64,
+    pmin_ph: f64,
+    load_error: f64,
+    its: f64,
+    steps: usize,
+}
+
+fn key_numbers(s: &Value) -> Option<Key> {
+    let ph = num(s, "hertz.ph_pa")?;
+    Some(Key {
+        hc: num(s, "film.hc_m")?,
+        hm: num(s, "film.hm_m")?,
+        pmin_ph: num(s, "pressure.pmin_nodes_pa")? / ph,
+        load_error: num(s, "pressure.load_error_rel")?,
+        its: num(s, "solver.newton_iterations")?,
+        steps: s.pointer("/solver/path").and_then(|p| p.as_array()).map(|a| a.len().saturating_sub(1)).unwrap_or(0),
+    })
+}
+
+/// Result leaves that are null (NaN or infinite when written).
+fn nan_keys(s: &Value) -> Vec<String> {
+    flatten(s)
+        .into_iter()
+        .filter(|(k, v)| *v == Leaf::Null && ["film.", "pressure.", "friction.", "solver."].iter().any(|p| k.starts_with(p)) && !k.contains("hamrock_dowson"))
+        .map(|(k, _)| k)
+        .collect()
+}
+
+/// The first clause of a failure message (the path of continuation steps is in the log).
+fn short_reason(e: &str) -> String {
+    let first = e.split("; path:").next().unwrap_or(e).split("; steps:").next().unwrap_or(e).split("; last domain error").next().unwrap_or(e);
+    if first.chars().count() > 120 {
+        format!("{}...", first.chars().take(120).collect::<String>())
+    } else {
+        first.to_string()
+    }
+}
+
+/// The checks of one case; returns the table row (Markdown) and the failed checks.
+pub fn check_case(name: &str, default: &Run, refined: &Run) -> (String, Vec<String>) {
+    let mut failed = Vec::new();
+    let mut keys = Vec::new();
+    for (label, run) in [("default", default), ("refined", refined)] {
+        match (&run.summary, &run.error) {
+            (Some(s), None) if s.get("converged").and_then(|c| c.as_bool()) == Some(true) => {
+                let nans = nan_keys(s);
+                if !nans.is_empty() {
+                    failed.push(format!("{label}: NaN in {}", nans.join(", ")));
+                }
+                match key_numbers(s) {
+                    Some(k) => {
+                        if k.pmin_ph < PMIN_OVER_PH {
+                            failed.push(format!("{label}: nodal p_min = {:.2e} p_H < {PMIN_OVER_PH:.0e} p_H", k.pmin_ph));
+                        }
+                        if k.hm <= 0.0 {
+                            failed.push(format!("{label}: h_min = {:.3e} m <= 0", k.hm));
+                        }
+                        if !(k.load_error < LOAD_ERROR) {
+                            failed.push(format!("{label}: load error {:.1e} >= {LOAD_ERROR:.0e}", k.load_error));
+                        }
+                        keys.push(Some(k));
+                    }
+                    None => {
+                        failed.push(format!("{label}: summary lacks film/pressure/solver numbers"));
+                        keys.push(None);
+                    }
+                }
+            }
+            (_, Some(e)) => {
+                failed.push(format!("{label}: did not converge ({})", short_reason(e)));
+                keys.push(None);
+            }
+            _ => {
+                failed.push(format!("{label}: no converged summary"));
+                keys.push(None);
+            }
+        }
+    }
+    let (dhc, dhm) = match (keys[0], keys[1]) {
+        (Some(d), Some(r)) => {
+            let (dhc, dhm) = ((d.hc - r.hc) / r.hc, (d.hm - r.hm) / r.hm);
+            if !(dhc.abs() < MESH_CHANGE) {
+                failed.push(format!("hc moves {:+.2} % between the meshes", 100.0 * dhc));
+            }
+            if !(dhm.abs() < MESH_CHANGE) {
+                failed.push(format!("hm moves {:+.2} % between the meshes", 100.0 * dhm));
+            }
+            (Some(dhc), Some(dhm))
+        }
+        _ => (None, None),
+    };
+    let m = default.summary.as_ref().or(refined.summary.as_ref()).and_then(|s| num(s, "moes.M"));
+    let pair = |f: &dyn Fn(&Key) -> String| format!("{} / {}", keys[0].as_ref().map(f).unwrap_or("-".into()), keys[1].as_ref().map(f).unwrap_or("-".into()));
+    let pct = |v: Option<f64>| v.map(|v| format!("{:+.2} %", 100.0 * v)).unwrap_or("-".into());
+    let worst = |f: &dyn Fn(&Key) -> f64, min: bool| {
+        let v: Vec<f64> = keys.iter().flatten().map(f).collect();
+        if v.is_empty() {
+            "-".to_string()
+        } else if min {
+            format!("{:.1e}", v.iter().cloned().fold(f64::INFINITY, f64::min))
+        } else {
+            format!("{:.1e}", v.iter().cloned().fold(0.0, f64::max))
+        }
+    };
+    let row = format!(
+        "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} / {:.0} | {} |\n",
+        m.map(|m| format!("{m:.0}")).unwrap_or("-".into()),
+        pair(&|_| "yes".into()).replace('-', "NO"),
+        pair(&|k| format!("{:.0}", k.its)),
+        pair(&|k| k.steps.to_string()),
+        pair(&|k| format!("{:.4}", k.hc * 1e6)),
+        pair(&|k| format!("{:.4}", k.hm * 1e6)),
+        pct(dhc),
+        pct(dhm),
+        worst(&|k| k.pmin_ph, true),
+        worst(&|k| k.load_error, false),
+        default.wall_s,
+        refined.wall_s,
+        if failed.is_empty() { "pass".to_string() } else { format!("FAIL: {}", failed.join("; ")) }
+    );
+    (row, failed)
+}
+
+/// Header of the hard suite's table.
+pub const HEADER: &str = "| case | M | converged (default / refined) | Newton its | continuation steps | hc (um) | hm (um) | hc change | hm change | min nodal p / p_H | max load error | wall (s) | verdict |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn run(hc: f64, hm: f64, pmin: f64) -> Run {
+        Run {
+            summary: Some(json!({
+                "converged": true, "hertz": {"ph_pa": 1e9}, "moes": {"M": 100.0},
+                "film": {"hc_m": hc, "hm_m": hm},
+                "pressure": {"pmin_nodes_pa": pmin, "load_error_rel": 1e-12},
+                "solver": {"newton_iterations": 12, "path": ["Newton", "continuation"]}
+            })),
+            wall_s: 10.0,
+            error: None,
+        }
+    }
+
+    #[test]
+    fn a_good_pair_passes() {
+        let (row, failed) = check_case("ok", &run(3.0e-7, 1.0e-7, -1e5), &run(3.01e-7, 1.01e-7, -2e5));
+        assert!(failed.is_empty(), "{failed:?}");
+        assert!(row.contains("| ok | 100 |") && row.ends_with("| pass |\n"), "{row}");
+    }
+
+    #[test]
+    fn each_check_can_fail() {
+        // hm moves 5 %, nodal p below -1e-3 p_H.
+        let (_, f) = check_case("bad", &run(3.0e-7, 1.05e-7, -2e6), &run(3.0e-7, 1.0e-7, 0.0));
+        assert_eq!(f.len(), 2, "{f:?}");
+        assert!(f.iter().any(|m| m.contains("hm moves +5.00 %")) && f.iter().any(|m| m.contains("p_min")));
+        // A failed refined run.
+        let failed_run = Run { summary: None, wall_s: 3.0, error: Some("DIVERGED_LINE_SEARCH".into()) };
+        let (row, f) = check_case("div", &run(3.0e-7, 1.0e-7, 0.0), &failed_run);
+        assert!(f[0].contains("refined: did not converge (DIVERGED_LINE_SEARCH)") && row.contains("FAIL"), "{row}");
+        // NaN written as null.
+        let mut r = run(3.0e-7, 1.0e-7, 0.0);
+        r.summary.as_mut().unwrap()["pressure"]["pmax_pa"] = serde_json::Value::Null;
+        let (_, f) = check_case("nan", &r, &run(3.0e-7, 1.0e-7, 0.0));
+        assert!(f.iter().any(|m| m.contains("NaN in pressure.pmax_pa")), "{f:?}");
+    }
+}

@@ -1,0 +1,104 @@
+//! Faults (issue 7): a solve interrupted by SIGINT/SIGTERM, on every rank or on one rank
+//! only, ends all ranks with a clear message, a non-zero exit and no result file (nothing
+//! half-written); and the regression runner catches a deliberately perturbed reference.
+mod common;
+use common::*;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// PIDs of the direct children of `pid` (mpirun's ranks).
+fn children(pid: u32) -> Vec<i32> {
+    let text = std::fs::read_to_string(format!("/proc/{pid}/task/{pid}/children")).unwrap_or_default();
+    text.split_whitespace().filter_map(|s| s.parse().ok()).collect()
+}
+
+/// Starts `mpirun -n 2 ehl-petsc` on the paper-mesh Table 2 scene, waits for the log line
+/// containing `wait_for`, then sends `sig` to mpirun (`to_mpirun`) or to one rank only.
+/// Returns (exit code, stderr, output folder).
+fn interrupt_run(name: &str, wait_for: &str, sig: i32, to_mpirun: bool) -> (Option<i32>, String, std::path::PathBuf) {
+    let out = scratch(name).join("out");
+    let scene = repo().join("cases/paper/table2-ue2.toml");
+    let mut cmd = Command::new("mpirun");
+    cmd.args(["-n", "2"]).arg(binary()).arg(&scene).arg("--output").arg(&out);
+    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OMPI_MCA_rmaps_base_oversubscribe", "1").env("OPENBLAS_NUM_THREADS", "1");
+    let mut child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("mpirun");
+    let pid = child.id();
+    let stdout = child.stdout.take().unwrap();
+    let mut seen = false;
+    let t0 = Instant::now();
+    for line in BufReader::new(stdout).lines() {
+        let line = line.unwrap();
+        if line.contains(wait_for) {
+            seen = true;
+            break;
+        }
+        assert!(t0.elapsed() < Duration::from_secs(300), "no '{wait_for}' line in 300 s");
+    }
+    assert!(seen, "the run ended before '{wait_for}'");
+    let target = if to_mpirun {
+        pid as i32
+    } else {
+        let ranks = children(pid);
+        assert_eq!(ranks.len(), 2, "expected 2 rank processes under mpirun, found {ranks:?}");
+        ranks[1]
+    };
+    unsafe { libc::kill(target, sig) };
+    let output = child.wait_with_output().unwrap();
+    (output.status.code(), String::from_utf8_lossy(&output.stderr).into_owned(), out)
+}
+
+fn assert_no_results(out: &Path) {
+    let files: Vec<String> = std::fs::read_dir(out).map(|d| d.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect()).unwrap_or_default();
+    assert!(files.is_empty(), "an interrupted run left files behind: {files:?}");
+}
+
+#[test]
+fn sigterm_on_one_rank_during_condensation_stops_both_ranks_cleanly() {
+    // The signal reaches rank 1 only (a batch system killing one task): rank 0 must not
+    // hang in a collective call; both stop at the next collective check.
+    let (code, stderr, out) = interrupt_run("fault-sigterm-one-rank", "symmetry:", libc::SIGTERM, false);
+    assert_ne!(code, Some(0), "{stderr}");
+    assert!(stderr.contains("interrupted by SIGTERM during the elastic condensation"), "{stderr}");
+    assert_eq!(stderr.matches("ehl-petsc: error").count(), 1, "one message, printed once: {stderr}");
+    assert_no_results(&out);
+}
+
+#[test]
+fn sigint_to_mpirun_during_newton_stops_cleanly() {
+    // Ctrl-C on mpirun: Open MPI forwards a SIGTERM to every rank.
+    let (code, stderr, out) = interrupt_run("fault-sigint-mpirun", "Newton from the Hertz start", libc::SIGINT, true);
+    assert_ne!(code, Some(0), "{stderr}");
+    assert!(stderr.contains("interrupted by SIG") && stderr.contains("during the Newton solve"), "{stderr}");
+    assert!(stderr.contains("no result of this solve was written"), "{stderr}");
+    assert_no_results(&out);
+}
+
+/// The regression runner against a copy of the data folder in which one reference number
+/// is moved by 1e-4 (100 x the tolerance): it must exit 1 and name the key; unmoved, it
+/// passes (one scene of the quick tier, 1 rank).
+#[test]
+fn regression_runner_catches_a_perturbed_reference() {
+    let data = scratch("regress-perturbed").join("data");
+    std::fs::create_dir_all(data.join("ref")).unwrap();
+    let src = repo().join("tests/regress");
+    std::fs::copy(src.join("tolerances.toml"), data.join("tolerances.toml")).unwrap();
+    let line = std::fs::read_to_string(src.join("quick.list")).unwrap().lines().find(|l| l.starts_with("table2-ue2-coarse")).expect("quick tier lists table2-ue2-coarse").to_string();
+    std::fs::write(data.join("quick.list"), format!("{line}\n")).unwrap();
+    let reference = std::fs::read_to_string(src.join("ref/table2-ue2-coarse.json")).unwrap();
+    let run = |label: &str| {
+        let out = Command::new(repo().join("ci/regress")).args(["-t", "quick", "-r", "1", "-o"]).arg(data.parent().unwrap().join(label)).env("REGRESS_DATA", &data).env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").output().unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr))
+    };
+    std::fs::write(data.join("ref/table2-ue2-coarse.json"), &reference).unwrap();
+    let (code, text) = run("as-is");
+    assert_eq!(code, Some(0), "the unmoved reference must pass:\n{text}");
+    let mut v: serde_json::Value = serde_json::from_str(&reference).unwrap();
+    let hc = v["film"]["hc_m"].as_f64().unwrap();
+    v["film"]["hc_m"] = serde_json::json!(hc * (1.0 + 1e-4));
+    std::fs::write(data.join("ref/table2-ue2-coarse.json"), serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    let (code, text) = run("perturbed");
+    assert_eq!(code, Some(1), "a reference moved by 1e-4 must fail:\n{text}");
+    assert!(text.contains("| film.hc_m |") && text.contains("DRIFT") && text.contains("FAILED"), "{text}");
+}
