@@ -332,6 +332,14 @@ impl EhlProblem for CondensedSystem<'_> {
         self.lubricant = lubricant;
     }
 
+    fn set_velocity(&mut self, velocity: Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync>) -> bool {
+        for e in &mut self.elements {
+            e.vel = e.verts.map(|v| velocity(v[0], v[1]));
+        }
+        self.params.velocity = velocity;
+        true
+    }
+
     /// Row scaling as in the monolithic system: each Reynolds row by the inverse of its
     /// dR/dP diagonal at `x` (constant afterwards).
     fn scale_rows(&mut self, x: &[f64]) -> Result<()> {

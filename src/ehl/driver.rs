@@ -83,11 +83,15 @@ fn dry_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &Part
     u.gather_all()
 }
 
+/// The scene's dimensionless entrainment velocity (Um, Wm)/Ue as a function of (X, Z).
+fn velocity_field(scene: &Scene) -> Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync> {
+    let kin = scene.kinematics().expect("lubricated scene");
+    let (a, ue) = (scene.scales().a, scene.operating.entrainment_speed.unwrap());
+    Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue])
+}
+
 /// EHL parameters of the scene (dimensionless).
 fn ehl_params(scene: &Scene, nu: f64, half: bool) -> EhlParams {
-    let scales = scene.scales();
-    let kin = scene.kinematics().expect("lubricated scene");
-    let (a, ue) = (scales.a, scene.operating.entrainment_speed.unwrap());
     let penalty = if scene.effects.cavitation == crate::case::CavitationModel::Penalty { scene.reynolds.penalty } else { 0.0 };
     EhlParams {
         lambda_bar: lambda_bar(scene),
@@ -95,7 +99,7 @@ fn ehl_params(scene: &Scene, nu: f64, half: bool) -> EhlParams {
         load: if half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 },
         penalty,
         stabilisation: stabilisation(scene, penalty),
-        velocity: Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue]),
+        velocity: velocity_field(scene),
         nu,
     }
 }
@@ -414,13 +418,18 @@ struct Homotopy {
     /// First t tried from the start, halved down to `lowest` until Newton converges.
     start: f64,
     lowest: f64,
-    apply: Box<dyn Fn(&mut Scene, f64)>,
+    apply: SceneAt,
     show: Box<dyn Fn(f64) -> String>,
+    /// The parameter changes the entrainment velocity field (tilt angle).
+    kinematic: bool,
 }
 
+/// Sets a scene's problem at continuation parameter t.
+type SceneAt = Box<dyn Fn(&mut Scene, f64)>;
+
 /// Newton from `x0` (described by `label`) at the scene's operating point; if that fails
-/// and `continuation` is set, a continuation in pressure-viscosity, then in load, then in
-/// speed, from a milder problem to the scene's (each step is logged and kept in the path).
+/// and `continuation` is set, a continuation in the tilt angle (spin), then in
+/// pressure-viscosity, then in load, then in speed, from a milder problem to the scene's (each step is logged and kept in the path).
 /// Returns the converged iterate (gathered) or an error naming the path taken.
 #[allow(clippy::too_many_arguments)]
 fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], label: &str, continuation: bool, j: &Matrix, (lo, hi): (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
@@ -511,8 +520,8 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
             last = r;
         }
     }
-    // 3. If it failed: continuation, first in pressure-viscosity, then in load, then in
-    //    speed. Each is a milder problem at one end (a smaller alpha: a less steep
+    // 3. If it failed: continuation, first (spin kinematics, lambda < 90 deg) in the tilt
+    //    angle, then in pressure-viscosity, then in load, then in speed. Each is a milder problem at one end (a smaller alpha: a less steep
     //    viscosity at the same Hertz geometry, so the Hertz start stays good; a lighter
     //    load in Hertz units: smaller M and alpha p_H; a higher speed: a thicker film) and
     //    the scene's at the other; each converged state starts the next. Pressure-viscosity
@@ -523,7 +532,18 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
         let alpha = scene.lubricant.as_ref().and_then(|l| l.pressure_viscosity).unwrap_or(0.0);
         let z = scene.lubricant.as_ref().and_then(|l| l.roelands_exponent);
         let ue = scene.operating.entrainment_speed.unwrap_or(0.0);
+        let tilt = scene.operating.tilt_angle;
+        // A small tilt angle (strong spin) is milder at a larger one; only with spin kinematics.
+        let spin = scene.effects.kinematics == crate::case::KinematicsModel::Spin && tilt < 90.0;
         let homotopies: Vec<Homotopy> = vec![
+            Homotopy {
+                name: "tilt",
+                start: 0.5,
+                lowest: 1.0 / 64.0,
+                apply: Box::new(move |sc: &mut Scene, t| sc.operating.tilt_angle = (tilt / t).min(90.0)),
+                show: Box::new(move |t| format!("lambda = {:.4} deg", (tilt / t).min(90.0))),
+                kinematic: true,
+            },
             Homotopy {
                 name: "pressure-viscosity",
                 start: 0.5,
@@ -535,17 +555,21 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
                     }
                 }),
                 show: Box::new(move |t| format!("alpha = {:.4} GPa^-1", alpha * t * 1e9)),
+                kinematic: false,
             },
-            Homotopy { name: "load", start: 1.0 / 8.0, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.load = target * t), show: Box::new(move |t| format!("L = {:.4} N", target * t)) },
-            Homotopy { name: "speed", start: 0.25, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.entrainment_speed = Some(ue / t)), show: Box::new(move |t| format!("Ue = {:.4} m/s", ue / t)) },
+            Homotopy { name: "load", start: 1.0 / 8.0, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.load = target * t), show: Box::new(move |t| format!("L = {:.4} N", target * t)), kinematic: false },
+            Homotopy { name: "speed", start: 0.25, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.entrainment_speed = Some(ue / t)), show: Box::new(move |t| format!("Ue = {:.4} m/s", ue / t)), kinematic: false },
         ];
         for h in &homotopies {
-            if h.name == "pressure-viscosity" && alpha == 0.0 {
+            if (h.name == "pressure-viscosity" && alpha == 0.0) || (h.kinematic && (!spin || !system.set_velocity(velocity_field(scene)))) {
                 continue;
             }
             let solve_h = |t: f64, system: &mut dyn EhlProblem, start: &[f64]| {
                 let mut sc = scene.clone();
                 (h.apply)(&mut sc, t);
+                if h.kinematic {
+                    system.set_velocity(velocity_field(&sc));
+                }
                 solve_scene(&sc, system, start)
             };
             // Find a milder problem Newton solves from the start.
@@ -586,6 +610,10 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
                         break;
                     }
                 }
+            }
+            if h.kinematic && !(t >= 1.0 && last.converged) {
+                // Back to the scene's own velocity field for what follows.
+                system.set_velocity(velocity_field(scene));
             }
             if t >= 1.0 && last.converged {
                 break;

@@ -258,6 +258,11 @@ pub trait EhlProblem: Problem {
     fn set_pseudo_time(&mut self, _dt: Option<f64>, _x: &[f64]) -> bool {
         false
     }
+    /// Replaces the entrainment velocity field (continuation in the tilt angle). Returns
+    /// false if the problem does not support it.
+    fn set_velocity(&mut self, _velocity: Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync>) -> bool {
+        false
+    }
 }
 
 impl EhlProblem for EhlSystem<'_> {

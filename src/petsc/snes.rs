@@ -62,7 +62,7 @@ unsafe extern "C" fn form_function(snes: ffi::SNES, x: ffi::Vec, f: ffi::Vec, ct
     // Every rank evaluates the residual together: the place to stop on SIGINT/SIGTERM.
     let sig = crate::interrupt::collective_signal();
     if sig != 0 {
-        ctx.error = Some(rust_error(&crate::interrupt::message(sig, "the Newton solve")));
+        ctx.error = Some(rust_error(crate::interrupt::message(sig, "the Newton solve")));
         return ffi::PETSC_ERR_LIB as ffi::PetscErrorCode;
     }
     let run = || -> Result<Eval> {
