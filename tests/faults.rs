@@ -23,6 +23,10 @@ fn interrupt_run(name: &str, wait_for: &str, sig: i32, to_mpirun: bool) -> (Opti
     let mut cmd = Command::new("mpirun");
     cmd.args(["-n", "2"]).arg(binary()).arg(&scene).arg("--output").arg(&out);
     cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OMPI_MCA_rmaps_base_oversubscribe", "1").env("OPENBLAS_NUM_THREADS", "1");
+    // Open MPI SIGKILLs the ranks 1 s after forwarding a signal (odls_base_sigkill_timeout);
+    // a rank in the middle of a factorisation on a loaded machine needs longer to reach its
+    // next check. ci/env.sh sets the same.
+    cmd.env("OMPI_MCA_odls_base_sigkill_timeout", "30");
     let mut child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("mpirun");
     let pid = child.id();
     let stdout = child.stdout.take().unwrap();
