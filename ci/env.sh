@@ -4,7 +4,3 @@
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
-# On Ctrl-C / SIGTERM mpirun forwards SIGTERM to the ranks and SIGKILLs them 1 s later by
-# default; ehl-petsc stops cleanly at its next collective check (one Newton residual, which
-# can take longer than 1 s on a fine mesh), so give it 30 s.
-export OMPI_MCA_odls_base_sigkill_timeout=30
