@@ -61,8 +61,13 @@ fn interrupt_run(name: &str, wait_for: &str, sig: i32, target: Target) -> (Optio
     (output.status.code(), String::from_utf8_lossy(&output.stderr).into_owned(), out)
 }
 
+/// Names of the files in `dir` (none if it does not exist).
+fn files_in(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir).map(|d| d.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect()).unwrap_or_default()
+}
+
 fn assert_no_results(out: &Path) {
-    let files: Vec<String> = std::fs::read_dir(out).map(|d| d.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect()).unwrap_or_default();
+    let files = files_in(out);
     assert!(files.is_empty(), "an interrupted run left files behind: {files:?}");
 }
 
@@ -98,7 +103,7 @@ fn sigint_to_mpirun_during_newton_ends_the_job_without_results() {
     // either nothing or a complete result with its summary.json.
     let (code, stderr, out) = interrupt_run("fault-sigint-mpirun", "Newton from the Hertz start", libc::SIGINT, Target::Mpirun);
     assert_ne!(code, Some(0), "{stderr}");
-    let files: Vec<String> = std::fs::read_dir(&out).map(|d| d.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect()).unwrap_or_default();
+    let files = files_in(&out);
     assert!(files.iter().all(|f| !f.contains(".tmp-")), "half-written files: {files:?}");
     assert!(files.is_empty() || files.iter().any(|f| f == "summary.json"), "results without a summary: {files:?}");
 }

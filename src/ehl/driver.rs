@@ -422,6 +422,8 @@ struct Homotopy {
     show: Box<dyn Fn(f64) -> String>,
     /// The parameter changes the entrainment velocity field (tilt angle).
     kinematic: bool,
+    /// The scene has this parameter to vary (alpha > 0; spin kinematics below 90 deg).
+    applies: bool,
 }
 
 /// Sets a scene's problem at continuation parameter t.
@@ -521,13 +523,14 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
         }
     }
     // 3. If it failed: continuation, first (spin kinematics, lambda < 90 deg) in the tilt
-    //    angle, then in pressure-viscosity, then in load, then in speed. Each is a milder problem at one end (a smaller alpha: a less steep
+    //    angle, then in pressure-viscosity, then in load, then in speed. Each is a milder
+    //    problem at one end (a larger tilt: weaker spin; a smaller alpha: a less steep
     //    viscosity at the same Hertz geometry, so the Hertz start stays good; a lighter
     //    load in Hertz units: smaller M and alpha p_H; a higher speed: a thicker film) and
     //    the scene's at the other; each converged state starts the next. Pressure-viscosity
-    //    goes first: on the hard suite it is the one that converges (alpha30 on the paper
-    //    mesh: load continuation fails from every Hertz start down to L/64, alpha/2 -> alpha
-    //    converges in 23 + 8 iterations).
+    //    goes before load: on the hard suite it is the one that converges (alpha30 on the
+    //    paper mesh: load continuation fails from every Hertz start down to L/64, alpha/2 ->
+    //    alpha converges in 23 + 8 iterations); the tilt only applies to spin scenes.
     if !last.converged && continuation {
         let alpha = scene.lubricant.as_ref().and_then(|l| l.pressure_viscosity).unwrap_or(0.0);
         let z = scene.lubricant.as_ref().and_then(|l| l.roelands_exponent);
@@ -543,6 +546,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
                 apply: Box::new(move |sc: &mut Scene, t| sc.operating.tilt_angle = (tilt / t).min(90.0)),
                 show: Box::new(move |t| format!("lambda = {:.4} deg", (tilt / t).min(90.0))),
                 kinematic: true,
+                applies: spin,
             },
             Homotopy {
                 name: "pressure-viscosity",
@@ -556,12 +560,14 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
                 }),
                 show: Box::new(move |t| format!("alpha = {:.4} GPa^-1", alpha * t * 1e9)),
                 kinematic: false,
+                applies: alpha > 0.0,
             },
-            Homotopy { name: "load", start: 1.0 / 8.0, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.load = target * t), show: Box::new(move |t| format!("L = {:.4} N", target * t)), kinematic: false },
-            Homotopy { name: "speed", start: 0.25, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.entrainment_speed = Some(ue / t)), show: Box::new(move |t| format!("Ue = {:.4} m/s", ue / t)), kinematic: false },
+            Homotopy { name: "load", start: 1.0 / 8.0, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.load = target * t), show: Box::new(move |t| format!("L = {:.4} N", target * t)), kinematic: false, applies: true },
+            Homotopy { name: "speed", start: 0.25, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.entrainment_speed = Some(ue / t)), show: Box::new(move |t| format!("Ue = {:.4} m/s", ue / t)), kinematic: false, applies: true },
         ];
         for h in &homotopies {
-            if (h.name == "pressure-viscosity" && alpha == 0.0) || (h.kinematic && (!spin || !system.set_velocity(velocity_field(scene)))) {
+            // A kinematic parameter also needs a problem whose velocity field can change.
+            if !h.applies || (h.kinematic && !system.set_velocity(velocity_field(scene))) {
                 continue;
             }
             let solve_h = |t: f64, system: &mut dyn EhlProblem, start: &[f64]| {

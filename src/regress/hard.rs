@@ -139,7 +139,7 @@ pub fn check_case(name: &str, default: &Run, refined: &Run) -> (String, Vec<Stri
     let row = format!(
         "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} / {:.0} | {} |\n",
         m.map(|m| format!("{m:.0}")).unwrap_or("-".into()),
-        pair(&|_| "yes".into()).replace('-', "NO"),
+        keys.iter().map(|k| if k.is_some() { "yes" } else { "NO" }).collect::<Vec<_>>().join(" / "),
         pair(&|k| format!("{:.0}", k.its)),
         pair(&|k| k.steps.to_string()),
         pair(&|k| format!("{:.4}", k.hc * 1e6)),
