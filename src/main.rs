@@ -41,6 +41,11 @@ struct Cli {
     /// writes study.csv, study.md and error plots
     #[arg(long, value_name = "N")]
     convergence_study: Option<usize>,
+    /// What the convergence study refines: "core" (the whole contact zone, then a core
+    /// square |X|, |Z| <= 1.25) or "ring" (only the ring mesh.ring_inner <= r <=
+    /// mesh.ring_outer around the Hertz circle: 0.125a, 0.0625a, 0.03125a, ...)
+    #[arg(long, value_name = "core|ring", default_value = "core")]
+    ladder: ehl_petsc::app::study::Ladder,
     /// Print the scene-file reference (every key, unit, range, default) as Markdown and exit
     #[arg(long)]
     scene_reference: bool,
@@ -77,6 +82,7 @@ fn main() {
         check_only: cli.check,
         quiet: cli.quiet,
         study_levels: cli.convergence_study,
+        ladder: cli.ladder,
         overrides: cli.set,
     };
     let code = ehl_petsc::app::run(world, opts);

@@ -30,6 +30,11 @@ pub fn mesh_spec(scene: &Scene, half_z: bool) -> mesh::MeshSpec {
             let w = scene.mesh.core_half_width;
             (mesh::Rect { x0: -w, x1: w, z0: -w, z1: if half_z { 0.0 } else { w } }, scene.mesh.core_size)
         }),
+        ring: (scene.mesh.ring_size > 0.0).then_some(mesh::Ring {
+            inner: scene.mesh.ring_inner,
+            outer: scene.mesh.ring_outer,
+            size: scene.mesh.ring_size,
+        }),
     }
 }
 

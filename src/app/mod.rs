@@ -24,6 +24,8 @@ pub struct RunOptions {
     pub quiet: bool,
     /// `--convergence-study N`: solve the scene on N meshes (see [`study`]).
     pub study_levels: Option<usize>,
+    /// `--ladder`: what the convergence study refines.
+    pub ladder: study::Ladder,
     /// `--set KEY=VALUE` scene overrides, applied before validation.
     pub overrides: Vec<String>,
 }
@@ -114,7 +116,7 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {
-        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => study::run(&ctx, &scene, n),
+        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => study::run(&ctx, &scene, n, opts.ladder),
         Some(_) => Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into()),
         None => simulate(&ctx, &scene),
     };

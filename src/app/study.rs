@@ -5,9 +5,13 @@
 //! makes against them. Writes `level_K/` (the usual outputs), `study.csv`, `study.md` and
 //! `study_error_vs_unknowns.png`, `study_error_vs_time.png`.
 //!
-//! Ladder of contact-zone sizes h (units of a): 0.5, 0.25 (plain meshes, `mesh.contact_size`),
-//! then 0.125, 0.0625, ... as a core over |X|, |Z| <= 1.25 on the 0.25a mesh (the paper
-//! scenes' construction). The scene's own `[mesh]` sizes are replaced.
+//! Two ladders ([`Ladder`]):
+//! - `core`: contact-zone sizes h (units of a) 0.5, 0.25 (plain meshes, `mesh.contact_size`),
+//!   then 0.125, 0.0625, ... as a core over |X|, |Z| <= 1.25 on the 0.25a mesh (the paper
+//!   scenes' construction). The scene's own `[mesh]` sizes are replaced.
+//! - `ring`: the scene's own mesh with the ring `mesh.ring_inner <= r <= mesh.ring_outer`
+//!   (around the Hertz circle, where the inlet build-up, the side lobes and the outlet
+//!   spike sit) refined to h = 0.125, 0.0625, 0.03125, ...
 use super::lubricated::{post_point, PointResult, Setup};
 use super::{collective, Context};
 use crate::case::Scene;
@@ -15,15 +19,41 @@ use crate::ehl::driver::EhlSolver;
 use crate::output::plot::{line_plot, LineOpts, Series, Style};
 use std::time::Instant;
 
-/// Contact-zone size of level k (units of a).
-pub fn level_size(k: usize) -> f64 {
-    0.5 / (1u64 << k) as f64
+/// Which part of the mesh a convergence study refines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ladder {
+    /// The whole contact zone, then a core square over |X|, |Z| <= 1.25.
+    Core,
+    /// Only the ring around the Hertz circle, on the scene's own mesh.
+    Ring,
 }
 
-/// The scene with the mesh of contact-zone size `h`.
-pub fn level_scene(scene: &Scene, h: f64) -> Scene {
+impl std::str::FromStr for Ladder {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "core" => Ok(Ladder::Core),
+            "ring" => Ok(Ladder::Ring),
+            _ => Err(format!("--ladder {s:?} is not allowed: use \"core\" or \"ring\"")),
+        }
+    }
+}
+
+/// Refined size of level k (units of a): the contact zone's (core ladder, 0.5, 0.25, ...)
+/// or the ring's (ring ladder, 0.125, 0.0625, ...).
+pub fn level_size(ladder: Ladder, k: usize) -> f64 {
+    match ladder {
+        Ladder::Core => 0.5 / (1u64 << k) as f64,
+        Ladder::Ring => 0.125 / (1u64 << k) as f64,
+    }
+}
+
+/// The scene with the mesh of level size `h`.
+pub fn level_scene(scene: &Scene, ladder: Ladder, h: f64) -> Scene {
     let mut s = scene.clone();
-    if h >= 0.25 {
+    if ladder == Ladder::Ring {
+        s.mesh.ring_size = h;
+    } else if h >= 0.25 {
         s.mesh.contact_size = h;
         s.mesh.core_size = 0.0;
     } else {
@@ -68,17 +98,22 @@ struct Level {
     r: PointResult,
 }
 
-pub fn run(ctx: &Context, scene: &Scene, levels: usize) -> Result<(), String> {
-    if !(2..=6).contains(&levels) {
-        return Err(format!("--convergence-study {levels}: the number of levels must be in [2, 6] (level 6 has a 0.015625a core)"));
+pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder) -> Result<(), String> {
+    let max = if ladder == Ladder::Core { 6 } else { 4 };
+    if !(2..=max).contains(&levels) {
+        return Err(format!(
+            "--convergence-study {levels}: the number of levels must be in [2, {max}] for the {ladder:?} ladder (its level {max} has a {} a {})",
+            level_size(ladder, max - 1),
+            if ladder == Ladder::Core { "core" } else { "ring" }
+        ));
     }
     if scene.is_sweep() {
         return Err("--convergence-study solves one operating point: remove [sweep] from the scene".into());
     }
     let mut rows: Vec<Level> = Vec::new();
     for k in 0..levels {
-        let h = level_size(k);
-        let sc = level_scene(scene, h);
+        let h = level_size(ladder, k);
+        let sc = level_scene(scene, ladder, h);
         ctx.log(format!("convergence study: level {} of {levels}, contact-zone size {h} a", k + 1));
         let t0 = Instant::now();
         let dir = ctx.out_dir.join(format!("level_{}", k + 1));
@@ -228,6 +263,9 @@ mod tests {
 
     #[test]
     fn ladder_halves_the_contact_zone_size() {
-        assert_eq!([0, 1, 2, 3].map(level_size), [0.5, 0.25, 0.125, 0.0625]);
+        assert_eq!([0, 1, 2, 3].map(|k| level_size(Ladder::Core, k)), [0.5, 0.25, 0.125, 0.0625]);
+        assert_eq!([0, 1, 2].map(|k| level_size(Ladder::Ring, k)), [0.125, 0.0625, 0.03125]);
+        assert_eq!("ring".parse::<Ladder>(), Ok(Ladder::Ring));
+        assert!("rings".parse::<Ladder>().unwrap_err().contains("\"core\" or \"ring\""));
     }
 }

@@ -184,6 +184,15 @@ impl Scene {
             }
         }
 
+        let m = &self.mesh;
+        if m.ring_outer <= m.ring_inner {
+            return Err(not_allowed(
+                "mesh.ring_outer",
+                m.ring_outer,
+                format!("must exceed mesh.ring_inner = {} (units of a)", fmt_num(m.ring_inner)),
+            ));
+        }
+
         let e = &self.effects;
         if let Some(l) = &self.lubricant {
             if l.roelands_exponent.is_some() && e.viscosity != ViscosityModel::Roelands {

@@ -675,6 +675,13 @@ pub struct MeshSettings {
     pub core_size: f64,
     /// Half width of the core square (units of a), default 1.25.
     pub core_half_width: f64,
+    /// Element size in the ring ring_inner <= sqrt(X^2 + Z^2) <= ring_outer around the
+    /// Hertz circle (units of a); 0 (default): no ring refinement.
+    pub ring_size: f64,
+    /// Inner radius of the ring (units of a), default 0.75.
+    pub ring_inner: f64,
+    /// Outer radius of the ring (units of a), default 1.25.
+    pub ring_outer: f64,
 }
 
 impl Default for MeshSettings {
@@ -685,6 +692,9 @@ impl Default for MeshSettings {
             growth: 0.5,
             core_size: 0.0,
             core_half_width: 1.25,
+            ring_size: 0.0,
+            ring_inner: 0.75,
+            ring_outer: 1.25,
         }
     }
 }
@@ -735,6 +745,27 @@ pub const MESH_FIELDS: &[Field] = &[
         "half width of the core square |X|, |Z| <= w",
         "a",
         Kind::Number(Range::Closed(0.25, 8.0)),
+        Presence::Default("1.25")
+    ),
+    f!(
+        "ring_size",
+        "element size in the ring around the Hertz circle, ring_inner <= r <= ring_outer (rounded down to 16/2^k; 0: no ring)",
+        "a",
+        Kind::Number(Range::Closed(0.0, 16.0)),
+        Presence::Default("0")
+    ),
+    f!(
+        "ring_inner",
+        "inner radius of the ring",
+        "a",
+        Kind::Number(Range::Closed(0.0, 8.0)),
+        Presence::Default("0.75")
+    ),
+    f!(
+        "ring_outer",
+        "outer radius of the ring (must exceed ring_inner)",
+        "a",
+        Kind::Number(Range::LeftOpen(0.0, 8.0)),
         Presence::Default("1.25")
     ),
 ];

@@ -638,6 +638,8 @@ fn bad_sweep_lists_name_the_element() {
 fn command_line_overrides_are_validated_like_the_file() {
     let set = |o: &[&str]| parse_scene_with(PAPER_SPIN, "x", &o.iter().map(|s| s.to_string()).collect::<Vec<_>>());
     // A number, a bare word (string), a new section key.
+    let e = set(&["mesh.ring_inner=1.5", "mesh.ring_outer=1.0"]).unwrap_err().to_string();
+    assert_eq!(e, "mesh.ring_outer = 1 is not allowed: must exceed mesh.ring_inner = 1.5 (units of a)");
     let s = set(&["operating.load=2000", "effects.friction=none", "mesh.core_size=0.0625"]).unwrap();
     assert_eq!(s.operating.load, 2000.0);
     assert_eq!(s.effects.friction, FrictionModel::Off);

@@ -30,7 +30,7 @@ mod tests;
 pub use locate::ContactLocator;
 pub use partition::{morton3, partition, Partition};
 pub use quality::{quality, tet_quality, Quality};
-pub use spec::{MeshSpec, Rect};
+pub use spec::{MeshSpec, Rect, Ring};
 
 /// A P2 tetrahedral mesh of the box with its contact face.
 #[derive(Clone, Debug, PartialEq)]
@@ -77,18 +77,23 @@ fn refined_bisector(spec: &MeshSpec, h: f64) -> refine::Bisector {
     let r = spec.contact;
     let (rlo, rhi) = ([r.x0, 0.0, r.z0], [r.x1, 0.0, r.z1]);
     let g = spec.growth;
-    let core = spec.core.map(|(c, size)| {
+    let dyadic = |size: f64| {
         let mut hc = spec::COARSE_CELL;
         while hc > size * (1.0 + 1e-12) {
             hc *= 0.5;
         }
-        ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], hc)
-    });
+        hc
+    };
+    let core = spec.core.map(|(c, size)| ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], dyadic(size)));
+    let ring = spec.ring.map(|r| (r.inner, r.outer, dyadic(r.size)));
     b.refine_and_close(|v, t| {
         let d = refine::bbox_distance(v, t, &rlo, &rhi);
         let mut target = h + g * d;
         if let Some((lo, hi, hc)) = &core {
             target = target.min(hc + g * refine::bbox_distance(v, t, lo, hi));
+        }
+        if let Some((r0, r1, hr)) = ring {
+            target = target.min(hr + g * refine::ring_distance(v, t, r0, r1));
         }
         refine::longest_edge(v, t) > 3f64.sqrt() * target * (1.0 + 1e-10)
     });

@@ -220,6 +220,26 @@ pub(crate) fn bbox_distance(v: &[[f64; 3]], t: &[u32; 4], lo: &[f64; 3], hi: &[f
     s.sqrt()
 }
 
+/// Distance from the bounding box of tet `t` to the annulus
+/// `r0 <= sqrt(x^2 + z^2) <= r1` on the plane `y = 0` (exact for the box: the
+/// radius is continuous over the box's (x, z) rectangle, and y is independent).
+pub(crate) fn ring_distance(v: &[[f64; 3]], t: &[u32; 4], r0: f64, r1: f64) -> f64 {
+    let range = |c: usize| {
+        t.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
+            let x = v[i as usize][c];
+            (lo.min(x), hi.max(x))
+        })
+    };
+    let ((x0, x1), (y0, y1), (z0, z1)) = (range(0), range(1), range(2));
+    let near = |a: f64, b: f64| if a > 0.0 { a } else if b < 0.0 { -b } else { 0.0 };
+    let far = |a: f64, b: f64| a.abs().max(b.abs());
+    let rmin = near(x0, x1).hypot(near(z0, z1));
+    let rmax = far(x0, x1).hypot(far(z0, z1));
+    let dxz = (r0 - rmax).max(rmin - r1).max(0.0);
+    let dy = (y0 - 0.0).max(-y1).max(0.0);
+    dxz.hypot(dy)
+}
+
 /// Signed `6 x volume` of a tetrahedron: `det[v1-v0, v2-v0, v3-v0]`.
 pub(crate) fn det6(p: [&[f64; 3]; 4]) -> f64 {
     let d = |a: &[f64; 3]| [a[0] - p[0][0], a[1] - p[0][1], a[2] - p[0][2]];
@@ -318,6 +338,19 @@ mod tests {
         });
         assert!((0..b.tets.len()).all(|i| !b.has_hanging(i)));
         assert!((volume(&b) - 4.0).abs() < 1e-13);
+    }
+
+    #[test]
+    fn ring_distance_cases() {
+        // A tet in the box [1.0, 2.0] x [-1, 0] x [0, 1]: radii 1 to sqrt(5).
+        let v = vec![[1.0, -1.0, 0.0], [2.0, -1.0, 0.0], [1.0, 0.0, 0.0], [1.0, -1.0, 1.0]];
+        let t = [0, 1, 2, 3];
+        assert_eq!(ring_distance(&v, &t, 0.5, 1.5), 0.0);
+        assert!((ring_distance(&v, &t, 0.25, 0.75) - 0.25).abs() < 1e-15);
+        assert!((ring_distance(&v, &t, 2.5, 3.0) - (2.5 - 5f64.sqrt())).abs() < 1e-15);
+        // Box straddling the origin: rmin = 0.
+        let w = vec![[-1.0, -2.0, -1.0], [1.0, -2.0, -1.0], [-1.0, -3.0, -1.0], [-1.0, -2.0, 1.0]];
+        assert!((ring_distance(&w, &t, 0.5, 1.0) - 2.0).abs() < 1e-15);
     }
 
     #[test]

@@ -47,6 +47,19 @@ pub struct MeshSpec {
     /// Optional finer core: a rectangle inside `contact` meshed with size `core.1`
     /// (rounded down to 16/2^k), grading away from it at the same growth.
     pub core: Option<(Rect, f64)>,
+    /// Optional finer ring: the annulus `inner <= sqrt(X^2 + Z^2) <= outer` meshed with
+    /// size `size` (rounded down to 16/2^k), grading away from it at the same growth.
+    /// It follows the Hertz circle, where the inlet build-up, the side lobes and the
+    /// outlet spike sit.
+    pub ring: Option<Ring>,
+}
+
+/// An annulus on the top face, centred on the origin, with its element size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ring {
+    pub inner: f64,
+    pub outer: f64,
+    pub size: f64,
 }
 
 impl MeshSpec {
@@ -65,6 +78,7 @@ impl MeshSpec {
             contact_size: 0.25,
             growth: 0.5,
             core: None,
+            ring: None,
         }
     }
 
@@ -131,6 +145,15 @@ impl MeshSpec {
         pos("depth", self.depth)?;
         pos("contact_size", self.contact_size)?;
         pos("growth", self.growth)?;
+        if let Some(r) = self.ring {
+            pos("ring size", r.size)?;
+            if !(r.inner.is_finite() && r.outer.is_finite() && r.inner >= 0.0 && r.outer > r.inner) {
+                return Err(format!(
+                    "mesh spec: ring radii must satisfy 0 <= inner < outer (got inner {}, outer {})",
+                    r.inner, r.outer
+                ));
+            }
+        }
         if self.contact_size < COARSE_CELL / f64::from(1u32 << MAX_LEVEL) {
             return Err(format!(
                 "mesh spec: contact_size {} is below the minimum 16/2^{MAX_LEVEL}",

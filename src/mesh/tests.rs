@@ -465,3 +465,35 @@ fn report() {
         );
     }
 }
+
+#[test]
+fn ring_refines_only_around_the_hertz_circle() {
+    // Half domain, h_c = 0.25 with a 0.0625 ring on 0.85 <= r <= 1.15.
+    let mut s = half_spec();
+    s.ring = Some(Ring { inner: 0.85, outer: 1.15, size: 0.0625 });
+    let m = generate(&s).unwrap();
+    check_conformity(&m);
+    check_no_hanging(&m);
+    check_p2(&m);
+    check_flags(&m);
+    assert!(rel_close(m.top_face_area_in_contact(), s.contact.area(), 1e-12));
+    let (mut in_ring, mut centre) = (0, 0);
+    for c in &m.contact_tris {
+        let p: Vec<[f64; 3]> = c[..3].iter().map(|&v| m.nodes[v as usize]).collect();
+        let edge = |a: usize, b: usize| ((p[a][0] - p[b][0]).powi(2) + (p[a][2] - p[b][2]).powi(2)).sqrt();
+        let longest = edge(0, 1).max(edge(1, 2)).max(edge(2, 0));
+        let r = |q: &[f64; 3]| q[0].hypot(q[2]);
+        let (rmin, rmax) = p.iter().map(r).fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+        if rmax >= 0.85 && rmin <= 1.15 {
+            // A triangle touching the ring has legs of at most the ring size.
+            assert!(longest <= 0.0625 * 2f64.sqrt() * (1.0 + 1e-12), "triangle at r in [{rmin}, {rmax}] has edge {longest}");
+            in_ring += 1;
+        }
+        if rmax < 0.4 {
+            // Far from the ring (distance >= 0.45) the mesh is coarser than the ring.
+            assert!(longest > 0.0625 * 2f64.sqrt() * (1.0 + 1e-12), "triangle at r <= {rmax} has edge {longest}");
+            centre += 1;
+        }
+    }
+    assert!(in_ring > 500 && centre > 0, "{in_ring} {centre}");
+}
