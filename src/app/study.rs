@@ -53,7 +53,10 @@ pub fn level_scene(scene: &Scene, ladder: Ladder, h: f64) -> Scene {
     let mut s = scene.clone();
     if ladder == Ladder::Ring {
         s.mesh.ring_size = h;
-    } else if h >= 0.25 {
+        return s;
+    }
+    s.mesh.ring_size = 0.0;
+    if h >= 0.25 {
         s.mesh.contact_size = h;
         s.mesh.core_size = 0.0;
     } else {
@@ -114,7 +117,7 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder) -> Resul
     for k in 0..levels {
         let h = level_size(ladder, k);
         let sc = level_scene(scene, ladder, h);
-        ctx.log(format!("convergence study: level {} of {levels}, contact-zone size {h} a", k + 1));
+        ctx.log(format!("convergence study: level {} of {levels}, {} size {h} a", k + 1, if ladder == Ladder::Ring { "ring" } else { "contact-zone" }));
         let t0 = Instant::now();
         let dir = ctx.out_dir.join(format!("level_{}", k + 1));
         ctx.create_dir(&dir)?;
@@ -266,6 +269,13 @@ mod tests {
         assert_eq!([0, 1, 2, 3].map(|k| level_size(Ladder::Core, k)), [0.5, 0.25, 0.125, 0.0625]);
         assert_eq!([0, 1, 2].map(|k| level_size(Ladder::Ring, k)), [0.125, 0.0625, 0.03125]);
         assert_eq!("ring".parse::<Ladder>(), Ok(Ladder::Ring));
+        // The ring ladder keeps the scene's mesh and sets the ring; the core ladder drops it.
+        let mut scene = crate::case::parse_scene(include_str!("../../cases/paper/table2-ue2.toml"), "x").unwrap();
+        scene.mesh.ring_size = 0.03125;
+        let r = level_scene(&scene, Ladder::Ring, 0.0625);
+        assert_eq!((r.mesh.ring_size, r.mesh.core_size, r.mesh.contact_size), (0.0625, scene.mesh.core_size, scene.mesh.contact_size));
+        let c = level_scene(&scene, Ladder::Core, 0.0625);
+        assert_eq!((c.mesh.ring_size, c.mesh.core_size, c.mesh.contact_size), (0.0, 0.0625, 0.25));
         assert!("rings".parse::<Ladder>().unwrap_err().contains("\"core\" or \"ring\""));
     }
 }
