@@ -1,6 +1,7 @@
 //! Table 2 of the paper (pure rolling, Ue = 2 m/s, L = 1500 N) on the scene's mesh (0.25 a,
-//! core of 0.125 a over |X|, |Z| <= 1.25) under 2 MPI ranks (about 2 minutes): Newton converges from the Hertz start with the default SUPG, the load
-//! balance closes, and hc, hm land near the paper's FEM values.
+//! core of 0.125 a over |X|, |Z| <= 1.25, ring of 0.0625 a on 0.85 <= r <= 1.15) under 2 MPI
+//! ranks (about 1 minute): Newton converges from the Hertz start with the default SUPG, the
+//! load balance closes, and hc, hm land near the paper's FEM values.
 //!
 //! Tolerances: the acceptance bands around the paper's FEM values (hc 0.40 um
 //! within 12 %, hm 0.16 um within 20 %). The paper's hc sits on Hamrock-Dowson, which
