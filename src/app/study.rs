@@ -39,6 +39,24 @@ impl std::str::FromStr for Ladder {
     }
 }
 
+impl Ladder {
+    /// The most levels the ladder offers.
+    fn max_levels(self) -> usize {
+        match self {
+            Ladder::Core => 6,
+            Ladder::Ring => 4,
+        }
+    }
+
+    /// What the ladder's size refers to, for messages.
+    fn sized(self) -> &'static str {
+        match self {
+            Ladder::Core => "contact-zone",
+            Ladder::Ring => "ring",
+        }
+    }
+}
+
 /// Refined size of level k (units of a): the contact zone's (core ladder, 0.5, 0.25, ...)
 /// or the ring's (ring ladder, 0.125, 0.0625, ...).
 pub fn level_size(ladder: Ladder, k: usize) -> f64 {
@@ -102,12 +120,12 @@ struct Level {
 }
 
 pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder) -> Result<(), String> {
-    let max = if ladder == Ladder::Core { 6 } else { 4 };
+    let max = ladder.max_levels();
     if !(2..=max).contains(&levels) {
         return Err(format!(
-            "--convergence-study {levels}: the number of levels must be in [2, {max}] for the {ladder:?} ladder (its level {max} has a {} a {})",
-            level_size(ladder, max - 1),
-            if ladder == Ladder::Core { "core" } else { "ring" }
+            "--convergence-study {levels}: the number of levels must be in [2, {max}] for the {ladder:?} ladder (its level {max} has a {} size of {} a)",
+            ladder.sized(),
+            level_size(ladder, max - 1)
         ));
     }
     if scene.is_sweep() {
@@ -117,7 +135,7 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder) -> Resul
     for k in 0..levels {
         let h = level_size(ladder, k);
         let sc = level_scene(scene, ladder, h);
-        ctx.log(format!("convergence study: level {} of {levels}, {} size {h} a", k + 1, if ladder == Ladder::Ring { "ring" } else { "contact-zone" }));
+        ctx.log(format!("convergence study: level {} of {levels}, {} size {h} a", k + 1, ladder.sized()));
         let t0 = Instant::now();
         let dir = ctx.out_dir.join(format!("level_{}", k + 1));
         ctx.create_dir(&dir)?;

@@ -205,32 +205,23 @@ pub(crate) fn dist(p: &[f64; 3], q: &[f64; 3]) -> f64 {
 /// `[lo, hi]` (which may be degenerate).
 pub(crate) fn bbox_distance(v: &[[f64; 3]], t: &[u32; 4], lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
     let mut s = 0.0;
-    for c in 0..3 {
-        let tmin = t
-            .iter()
-            .map(|&i| v[i as usize][c])
-            .fold(f64::INFINITY, f64::min);
-        let tmax = t
-            .iter()
-            .map(|&i| v[i as usize][c])
-            .fold(f64::NEG_INFINITY, f64::max);
+    for (c, (tmin, tmax)) in tet_ranges(v, t).into_iter().enumerate() {
         let gap = (lo[c] - tmax).max(tmin - hi[c]).max(0.0);
         s += gap * gap;
     }
     s.sqrt()
 }
 
+/// Coordinate ranges `(min, max)` of tet `t` along x, y and z (its bounding box).
+fn tet_ranges(v: &[[f64; 3]], t: &[u32; 4]) -> [(f64, f64); 3] {
+    std::array::from_fn(|c| t.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| (lo.min(v[i as usize][c]), hi.max(v[i as usize][c]))))
+}
+
 /// Distance from the bounding box of tet `t` to the annulus
 /// `r0 <= sqrt(x^2 + z^2) <= r1` on the plane `y = 0` (exact for the box: the
 /// radius is continuous over the box's (x, z) rectangle, and y is independent).
 pub(crate) fn ring_distance(v: &[[f64; 3]], t: &[u32; 4], r0: f64, r1: f64) -> f64 {
-    let range = |c: usize| {
-        t.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
-            let x = v[i as usize][c];
-            (lo.min(x), hi.max(x))
-        })
-    };
-    let ((x0, x1), (y0, y1), (z0, z1)) = (range(0), range(1), range(2));
+    let [(x0, x1), (y0, y1), (z0, z1)] = tet_ranges(v, t);
     let near = |a: f64, b: f64| if a > 0.0 { a } else if b < 0.0 { -b } else { 0.0 };
     let far = |a: f64, b: f64| a.abs().max(b.abs());
     let rmin = near(x0, x1).hypot(near(z0, z1));
