@@ -15,7 +15,7 @@ use crate::reynolds::element::{reynolds_element, ElementOut, Fluid};
 use crate::solid::condense::Compliance;
 
 /// Numbering of the condensed unknowns: P in `comp.cols` order, then H0; rank r owns
-/// `ranges[r]..ranges[r + 1]` (the last rank owns H0).
+/// `ranges[r]..ranges[r + 1]` (H0, the last row, is on the last rank with rows).
 #[derive(Debug, Clone)]
 pub struct CondensedLayout {
     pub n_p: usize,
@@ -37,8 +37,11 @@ impl CondensedLayout {
         for (i, &n) in comp.rows.iter().enumerate() {
             face_index[n as usize] = i as i32;
         }
+        // Equal blocks of ceil(total / nranks) rows, the last rank the remainder: the row
+        // layout the dense ScaLAPACK Jacobian requires.
         let total = n_p + 1;
-        let ranges = (0..=nranks).map(|r| if r == nranks { total } else { r * n_p / nranks }).collect();
+        let chunk = total.div_ceil(nranks);
+        let ranges = (0..=nranks).map(|r| (r * chunk).min(total)).collect();
         CondensedLayout { n_p, ranges, p_index, face_index }
     }
     pub fn total(&self) -> usize {
@@ -67,6 +70,53 @@ struct Element {
     mine: bool,
 }
 
+/// The block of the dense condensed Jacobian one rank fills: its rows and columns (global
+/// indices), their positions in the block (-1: not in it), and the compliance restricted
+/// to the block's columns (None when the block has every column: `Compliance::c` itself).
+struct FillBlock {
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    row_pos: Vec<i32>,
+    col_pos: Vec<i32>,
+    c_cols: Option<Vec<f64>>,
+}
+
+impl FillBlock {
+    fn new(rows: Vec<usize>, cols: Vec<usize>, comp: &Compliance, total: usize) -> Self {
+        let positions = |ix: &[usize]| {
+            let mut pos = vec![-1i32; total];
+            for (k, &i) in ix.iter().enumerate() {
+                pos[i] = k as i32;
+            }
+            pos
+        };
+        let (row_pos, col_pos) = (positions(&rows), positions(&cols));
+        let np = comp.cols.len();
+        let all = cols.len() == total && cols.iter().enumerate().all(|(k, &c)| k == c);
+        // The H0 column has no compliance: 0 in the restricted copy.
+        let c_cols = (!all && !comp.is_rigid()).then(|| comp.c.chunks_exact(np).flat_map(|crow| cols.iter().map(|&c| if c < np { crow[c] } else { 0.0 })).collect());
+        FillBlock { rows, cols, row_pos, col_pos, c_cols }
+    }
+
+    /// Compliance row of face node `f` on the block's columns (with every column, the P
+    /// columns only: zipping stops before H0).
+    fn c_row<'c>(&'c self, comp: &'c Compliance, f: usize) -> &'c [f64] {
+        match &self.c_cols {
+            Some(c) => &c[f * self.cols.len()..(f + 1) * self.cols.len()],
+            None => {
+                let np = comp.cols.len();
+                &comp.c[f * np..(f + 1) * np]
+            }
+        }
+    }
+}
+
+/// Slope of the cavitation penalty in the Jacobian at P: exact for the smoothed law; with
+/// the plain min(P, 0) (no smoothing) at least 1, so the kink's active set includes P >= 0.
+fn penalty_slope(p: f64) -> f64 {
+    penalty_law(p).1.max(if CAVITATION_SMOOTHING > 0.0 { 0.0 } else { 1.0 })
+}
+
 /// The condensed EHL problem on one rank (all data replicated; rows distributed).
 pub struct CondensedSystem<'a> {
     pub comp: &'a Compliance,
@@ -77,12 +127,16 @@ pub struct CondensedSystem<'a> {
     pub params: EhlParams,
     pub lubricant: Lubricant,
     elements: Vec<Element>,
-    /// (pressure unknown, face index, nodal area) of the owned pressure rows.
-    penalty_nodes: Vec<(usize, usize, f64)>,
+    /// Face index of each pressure unknown.
+    p_face: Vec<usize>,
+    /// Nodal area (integral of the P2 or P1 hat function) of each pressure unknown.
+    p_area: Vec<f64>,
+    /// The block of the dense Jacobian this rank fills (default: its rows, all columns).
+    fill: FillBlock,
     /// Rigid gap at each face node.
     gap: Vec<f64>,
     row_scale: Vec<f64>,
-    /// Pseudo-transient term (dt, rho H at the previous pseudo time at each owned P row's
+    /// Pseudo-transient term (dt, rho H at the previous pseudo time at each P unknown's
     /// node): area_j (rho_j H_j - old_j) / dt is added to Reynolds row j. None: steady.
     pseudo: Option<(f64, Vec<f64>)>,
     pub residual_evals: usize,
@@ -137,12 +191,9 @@ impl<'a> CondensedSystem<'a> {
                 mine: p.iter().any(|&d| owned(d)),
             });
         }
-        let penalty_nodes = (lo..hi)
-            .map(|j| {
-                let f = layout.face_index[comp.cols[j] as usize] as usize;
-                (j, f, node_area[f])
-            })
-            .collect();
+        let p_face: Vec<usize> = comp.cols.iter().map(|&n| layout.face_index[n as usize] as usize).collect();
+        let p_area = p_face.iter().map(|&f| node_area[f]).collect();
+        let fill = FillBlock::new((lo..layout.ranges[rank + 1]).collect(), (0..layout.total()).collect(), comp, layout.total());
         let gap = comp.rows.iter().map(|&n| super::layout::Layout::gap(mesh.nodes[n as usize])).collect();
         let row_scale = vec![1.0; layout.total()];
         CondensedSystem {
@@ -153,7 +204,9 @@ impl<'a> CondensedSystem<'a> {
             params,
             lubricant,
             elements,
-            penalty_nodes,
+            p_face,
+            p_area,
+            fill,
             gap,
             row_scale,
             pseudo: None,
@@ -166,6 +219,18 @@ impl<'a> CondensedSystem<'a> {
 
     fn owned(&self) -> (usize, usize) {
         (self.layout.ranges[self.rank], self.layout.ranges[self.rank + 1])
+    }
+
+    /// The pressure unknowns among this rank's rows.
+    fn owned_p(&self) -> std::ops::Range<usize> {
+        let (lo, hi) = self.owned();
+        lo..hi.min(self.layout.n_p)
+    }
+
+    /// Fill the dense Jacobian's block (`rows` x `cols`, global indices) on this rank
+    /// instead of its own rows and all columns: the share a `MATSCALAPACK` stores.
+    pub fn set_fill_block(&mut self, rows: Vec<usize>, cols: Vec<usize>) {
+        self.fill = FillBlock::new(rows, cols, self.comp, self.layout.total());
     }
 
     /// The load integral of the pressure of x (dimensionless).
@@ -280,10 +345,9 @@ impl<'a> CondensedSystem<'a> {
                 j.add_values(&[r as i32], &cols, &vals)?;
             }
         }
-        for &(jn, _, area) in &self.penalty_nodes {
-            let (_, dv) = penalty_law(x[jn]);
-            let dv = dv.max(if CAVITATION_SMOOTHING > 0.0 { 0.0 } else { 1.0 });
-            j.add_values(&[jn as i32], &[jn as i32], &[self.row_scale[jn] * self.params.penalty * area * dv])?;
+        for jn in self.owned_p() {
+            let dv = penalty_slope(x[jn]);
+            j.add_values(&[jn as i32], &[jn as i32], &[self.row_scale[jn] * self.params.penalty * self.p_area[jn] * dv])?;
         }
         if hi > np {
             if self.fixed_h0.is_some() {
@@ -321,7 +385,7 @@ impl EhlProblem for CondensedSystem<'_> {
     fn set_pseudo_time(&mut self, dt: Option<f64>, x: &[f64]) -> bool {
         self.pseudo = dt.map(|dt| {
             let h = self.film(x);
-            let old = self.penalty_nodes.iter().map(|&(j, f, _)| (self.lubricant.rho)(x[j]).0 * h[f]).collect();
+            let old = self.p_face.iter().enumerate().map(|(j, &f)| (self.lubricant.rho)(x[j]).0 * h[f]).collect();
             (dt, old)
         });
         true
@@ -345,8 +409,10 @@ impl EhlProblem for CondensedSystem<'_> {
     fn scale_rows(&mut self, x: &[f64]) -> Result<()> {
         let h = self.film(x);
         let fluid = self.fluid();
+        // Every row's scale (not only this rank's rows): the dense Jacobian's block may hold
+        // any row.
         let mut diag = vec![0.0; self.layout.total()];
-        for e in self.elements.iter().filter(|e| e.mine) {
+        for e in &self.elements {
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
             let out = self.eval(e, &p, &he, &fluid);
@@ -387,12 +453,12 @@ impl Problem for CondensedSystem<'_> {
                 }
             }
         }
-        for &(j, _, area) in &self.penalty_nodes {
-            r[j - lo] += self.params.penalty * area * penalty_law(x[j]).0;
+        for j in self.owned_p() {
+            r[j - lo] += self.params.penalty * self.p_area[j] * penalty_law(x[j]).0;
         }
         if let Some((dt, old)) = &self.pseudo {
-            for (k, &(j, f, area)) in self.penalty_nodes.iter().enumerate() {
-                r[j - lo] += area * ((self.lubricant.rho)(x[j]).0 * h[f] - old[k]) / dt;
+            for j in self.owned_p() {
+                r[j - lo] += self.p_area[j] * ((self.lubricant.rho)(x[j]).0 * h[self.p_face[j]] - old[j]) / dt;
             }
         }
         for (i, v) in r.iter_mut().enumerate() {
@@ -459,80 +525,85 @@ impl Problem for CondensedSystem<'_> {
         if self.comp.is_rigid() && self.pseudo.is_none() {
             return self.jacobian_rigid(x, j);
         }
-        let (lo, hi) = self.owned();
-        let n = self.layout.total();
         let np = self.layout.n_p;
         let h = self.film(x);
         let fluid = self.fluid();
-        let mut buf = vec![0.0; (hi - lo) * n];
-        for e in self.elements.iter().filter(|e| e.mine) {
+        let fb = &self.fill;
+        let ncl = fb.cols.len();
+        let mut buf = vec![0.0; fb.rows.len() * ncl];
+        let h0_col = fb.col_pos[np];
+        for e in &self.elements {
+            if !e.p.iter().any(|&d| d >= 0 && fb.row_pos[d as usize] >= 0) {
+                continue;
+            }
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
             let out = self.eval(e, &p, &he, &fluid);
             for i in 0..6 {
-                let Some(l) = self.own_row(e.p[i]) else { continue };
-                let row = &mut buf[l * n..(l + 1) * n];
+                if e.p[i] < 0 || fb.row_pos[e.p[i] as usize] < 0 {
+                    continue;
+                }
+                let l = fb.row_pos[e.p[i] as usize] as usize;
+                let row = &mut buf[l * ncl..(l + 1) * ncl];
                 for k in 0..6 {
-                    if e.p[k] >= 0 {
-                        row[e.p[k] as usize] += out.dr_dp[i][k];
+                    if e.p[k] >= 0 && fb.col_pos[e.p[k] as usize] >= 0 {
+                        row[fb.col_pos[e.p[k] as usize] as usize] += out.dr_dp[i][k];
                     }
                     // H = H0 + gap - U_y with U_y = C P: dH/dP = -C, dH/dH0 = 1.
                     let g = out.dr_dh[i][k];
                     if g != 0.0 {
                         if !self.comp.is_rigid() {
-                            let crow = &self.comp.c[e.face[k] * np..(e.face[k] + 1) * np];
-                            for (a, c) in row[..np].iter_mut().zip(crow) {
+                            for (a, c) in row.iter_mut().zip(fb.c_row(self.comp, e.face[k])) {
                                 *a -= g * c;
                             }
                         }
-                        row[np] += g;
+                        if h0_col >= 0 {
+                            row[h0_col as usize] += g;
+                        }
                     }
                 }
             }
         }
-        for &(jn, _, area) in &self.penalty_nodes {
-            let (_, dv) = penalty_law(x[jn]);
-            let dv = dv.max(if CAVITATION_SMOOTHING > 0.0 { 0.0 } else { 1.0 });
-            buf[(jn - lo) * n + jn] += self.params.penalty * area * dv;
-        }
-        if let Some((dt, _)) = &self.pseudo {
-            for &(jn, f, area) in &self.penalty_nodes {
+        for (l, &jn) in fb.rows.iter().enumerate().filter(|(_, &r)| r < np) {
+            let row = &mut buf[l * ncl..(l + 1) * ncl];
+            let area = self.p_area[jn];
+            if fb.col_pos[jn] >= 0 {
+                row[fb.col_pos[jn] as usize] += self.params.penalty * area * penalty_slope(x[jn]);
+            }
+            if let Some((dt, _)) = &self.pseudo {
+                let f = self.p_face[jn];
                 let (rho, drho) = (self.lubricant.rho)(x[jn]);
-                let row = &mut buf[(jn - lo) * n..(jn - lo + 1) * n];
                 // d(rho H)/dP_k = rho' H delta_jk - rho C[f, k]; d/dH0 = rho.
-                row[jn] += area * drho * h[f] / dt;
+                if fb.col_pos[jn] >= 0 {
+                    row[fb.col_pos[jn] as usize] += area * drho * h[f] / dt;
+                }
                 if !self.comp.is_rigid() {
-                    let crow = &self.comp.c[f * np..(f + 1) * np];
-                    for (a, c) in row[..np].iter_mut().zip(crow) {
+                    for (a, c) in row.iter_mut().zip(fb.c_row(self.comp, f)) {
                         *a -= area * rho * c / dt;
                     }
                 }
-                row[np] += area * rho / dt;
+                if h0_col >= 0 {
+                    row[h0_col as usize] += area * rho / dt;
+                }
             }
+            let s = self.row_scale[jn];
+            row.iter_mut().for_each(|v| *v *= s);
         }
-        for r in lo..hi.min(np) {
-            let s = self.row_scale[r];
-            for v in &mut buf[(r - lo) * n..(r - lo + 1) * n] {
-                *v *= s;
-            }
-        }
-        if hi > np {
+        if fb.row_pos[np] >= 0 {
             // Load row: integral of P.
-            let row = &mut buf[(np - lo) * n..];
+            let l = fb.row_pos[np] as usize;
+            let row = &mut buf[l * ncl..(l + 1) * ncl];
             for e in &self.elements {
-                let w = e.w;
                 for k in 0..6 {
-                    if e.p[k] >= 0 {
-                        row[e.p[k] as usize] += w[k];
+                    if e.p[k] >= 0 && fb.col_pos[e.p[k] as usize] >= 0 {
+                        row[fb.col_pos[e.p[k] as usize] as usize] += e.w[k];
                     }
                 }
             }
         }
-        j.zero()?;
-        let cols: Vec<i32> = (0..n as i32).collect();
-        for r in lo..hi {
-            j.add_values(&[r as i32], &cols, &buf[(r - lo) * n..(r - lo + 1) * n])?;
-        }
+        let rows: Vec<i32> = fb.rows.iter().map(|&r| r as i32).collect();
+        let cols: Vec<i32> = fb.cols.iter().map(|&c| c as i32).collect();
+        j.set_values(&rows, &cols, &buf)?;
         Ok(())
     }
 }

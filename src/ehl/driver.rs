@@ -174,7 +174,10 @@ impl<'a> EhlSolver<'a> {
             // The condensation's 3D Cholesky has its own prefix and keeps PORD.
             petsc::options::set_default("-elastic_mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
         }
-        petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
+        if monolithic {
+            // The condensed path picks its solver by the Jacobian's type (see `solve_condensed`).
+            petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
+        }
         let t0 = std::time::Instant::now();
         let rigid = scene.effects.elasticity == crate::case::ElasticityModel::Rigid;
         let p_nodes: Vec<u32> = mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect();
@@ -228,6 +231,10 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
 
 /// The condensed path: Newton on (P, H0) with the face compliance `comp`, from the Hertz
 /// start or from a previous state `start` (monolithic layout).
+/// Options prefix of the condensed Newton Jacobian (`-condensed_mat_type aij` with
+/// `-pc_factor_mat_solver_type mumps` returns to the sparse-format MUMPS LU).
+pub const CONDENSED_PREFIX: &std::ffi::CStr = c"condensed_";
+
 fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, comp: &crate::solid::condense::Compliance, half: bool, start: Option<&[f64]>) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
@@ -262,7 +269,15 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
         }
     };
     let (d_nnz, o_nnz) = system.preallocation();
-    let j = Matrix::new_aij(comm, cl.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?;
+    let j = if comp.is_rigid() {
+        Matrix::new_aij(comm, cl.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?
+    } else {
+        let j = Matrix::new_dense(comm, cl.local(ctx.rank), CONDENSED_PREFIX, &d_nnz, &o_nnz).map_err(pe)?;
+        let (rows, cols) = j.dense_fill_block(cl.total()).map_err(pe)?;
+        system.set_fill_block(rows, cols);
+        j
+    };
+    petsc::ksp::set_direct_solver_defaults_for("", &j).map_err(pe)?;
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
     let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);

@@ -15,6 +15,20 @@ pub fn set_direct_solver_defaults(prefix: &str) -> Result<()> {
     Ok(())
 }
 
+/// Direct-solver defaults for the matrix `a`, by its type: PETSc's own LAPACK LU for a
+/// sequential dense matrix, ScaLAPACK for `MATSCALAPACK`, MUMPS otherwise. The user's
+/// flags override each of them.
+pub fn set_direct_solver_defaults_for(prefix: &str, a: &Matrix) -> Result<()> {
+    options::set_default(&format!("-{prefix}ksp_type"), "preonly")?;
+    options::set_default(&format!("-{prefix}pc_type"), "lu")?;
+    let solver = match a.type_name()?.as_str() {
+        "seqdense" => "petsc",
+        "scalapack" => "scalapack",
+        _ => "mumps",
+    };
+    options::set_default(&format!("-{prefix}pc_factor_mat_solver_type"), solver)
+}
+
 /// A Krylov solver context (any KSP/PC through PETSc options).
 pub struct Ksp {
     raw: ffi::KSP,

@@ -2,6 +2,7 @@
 use super::error::{rust_error, Result};
 use super::ffi;
 use crate::pcall;
+use std::ffi::CStr;
 
 /// A square distributed AIJ matrix (`MATAIJ`: SeqAIJ on one rank, MPIAIJ on several).
 pub struct Matrix {
@@ -28,6 +29,39 @@ impl Matrix {
         Ok(m)
     }
 
+    /// A square dense matrix with `local_rows` rows on this rank, for a Jacobian that is
+    /// dense by nature (the condensed EHL system). One rank: `MATSEQDENSE`, factorised by
+    /// LAPACK (PETSc's own LU); several: `MATSCALAPACK` (2D block-cyclic, factorised by
+    /// ScaLAPACK; rows set by their PETSc owner travel through the stash at assembly).
+    /// `MatSetFromOptions` with the prefix `prefix` lets the user pick another type
+    /// (`-{prefix}mat_type aij` and a sparse direct solver); for a sparse type the
+    /// preallocation `d_nnz`, `o_nnz` applies.
+    pub fn new_dense(comm: ffi::MPI_Comm, local_rows: usize, prefix: &CStr, d_nnz: &[i32], o_nnz: &[i32]) -> Result<Matrix> {
+        let mut size = 0;
+        unsafe { mpi::ffi::MPI_Comm_size(comm, &mut size) };
+        let mut raw: ffi::Mat = std::ptr::null_mut();
+        pcall!(ffi::MatCreate(comm, &mut raw))?;
+        let m = Matrix { raw };
+        let n = local_rows as ffi::PetscInt;
+        pcall!(ffi::MatSetSizes(m.raw, n, n, ffi::PETSC_DETERMINE, ffi::PETSC_DETERMINE))?;
+        let ty = if size > 1 { ffi::MATSCALAPACK.as_ptr() } else { ffi::MATSEQDENSE.as_ptr() };
+        pcall!(ffi::MatSetType(m.raw, ty as *const _))?;
+        pcall!(ffi::MatSetOptionsPrefix(m.raw, prefix.as_ptr()))?;
+        pcall!(ffi::MatSetFromOptions(m.raw))?;
+        // Ignored by the dense types; exact for AIJ.
+        pcall!(ffi::MatSeqAIJSetPreallocation(m.raw, 0, d_nnz.as_ptr()))?;
+        pcall!(ffi::MatMPIAIJSetPreallocation(m.raw, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()))?;
+        pcall!(ffi::MatSetUp(m.raw))?;
+        Ok(m)
+    }
+
+    /// The matrix type name (`seqdense`, `scalapack`, `mpiaij`, ...).
+    pub fn type_name(&self) -> Result<String> {
+        let mut t: ffi::MatType = std::ptr::null();
+        pcall!(ffi::MatGetType(self.raw, &mut t))?;
+        Ok(unsafe { CStr::from_ptr(t) }.to_string_lossy().into_owned())
+    }
+
     /// Adds a dense block `vals` (row-major, rows.len() x cols.len()) at global indices.
     /// Negative indices are ignored by PETSc (used for eliminated Dirichlet dofs).
     pub fn add_values(&self, rows: &[i32], cols: &[i32], vals: &[f64]) -> Result<()> {
@@ -43,6 +77,52 @@ impl Matrix {
             vals.as_ptr(),
             ffi::InsertMode_ADD_VALUES
         ))
+    }
+
+    /// Sets (overwrites) a dense block `vals` (row-major, rows.len() x cols.len()).
+    pub fn set_values(&self, rows: &[i32], cols: &[i32], vals: &[f64]) -> Result<()> {
+        if vals.len() != rows.len() * cols.len() {
+            return Err(rust_error("Matrix::set_values: block size mismatch"));
+        }
+        pcall!(ffi::MatSetValues(
+            self.raw,
+            rows.len() as ffi::PetscInt,
+            rows.as_ptr(),
+            cols.len() as ffi::PetscInt,
+            cols.as_ptr(),
+            vals.as_ptr(),
+            ffi::InsertMode_INSERT_VALUES
+        ))
+    }
+
+    /// The (rows, columns) block of a dense matrix whose entries this rank stores: for
+    /// `MATSCALAPACK` its share of the 2D block-cyclic distribution (filling exactly that
+    /// block sends nothing at assembly); for every other type the owned rows and all
+    /// `n` columns.
+    pub fn dense_fill_block(&self, n: usize) -> Result<(Vec<usize>, Vec<usize>)> {
+        let all: Vec<usize> = (0..n).collect();
+        if self.type_name()? != "scalapack" {
+            let (mut lo, mut hi) = (0, 0);
+            pcall!(ffi::MatGetOwnershipRange(self.raw, &mut lo, &mut hi))?;
+            return Ok(((lo as usize..hi as usize).collect(), all));
+        }
+        let (mut ris, mut cis): (ffi::IS, ffi::IS) = (std::ptr::null_mut(), std::ptr::null_mut());
+        pcall!(ffi::MatGetOwnershipIS(self.raw, &mut ris, &mut cis))?;
+        let read = |is: ffi::IS| -> Result<Vec<usize>> {
+            let mut len: ffi::PetscInt = 0;
+            pcall!(ffi::ISGetLocalSize(is, &mut len))?;
+            let mut p: *const ffi::PetscInt = std::ptr::null();
+            pcall!(ffi::ISGetIndices(is, &mut p))?;
+            let v = unsafe { std::slice::from_raw_parts(p, len as usize) }.iter().map(|&i| i as usize).collect();
+            pcall!(ffi::ISRestoreIndices(is, &mut p))?;
+            Ok(v)
+        };
+        let out = read(ris).and_then(|r| Ok((r, read(cis)?)));
+        unsafe {
+            ffi::ISDestroy(&mut ris);
+            ffi::ISDestroy(&mut cis);
+        }
+        out
     }
 
     /// Final assembly (communicates off-rank entries).

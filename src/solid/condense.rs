@@ -144,18 +144,21 @@ fn face_mass(mesh: &Mesh, rows: &[u32], cols: &[u32]) -> Vec<f64> {
 /// Computes the face compliance of the equivalent solid (Poisson ratio `nu`, traction
 /// factor `traction`) for the pressure nodes `cols`. Collective over `world`; the result
 /// is on every rank.
+///
+/// Rank 0 computes the Schur complement S (MUMPS supports it only sequentially) and
+/// broadcasts it; then every rank solves S X = -c M for its share of the pressure columns
+/// (dense Cholesky: S is symmetric positive definite) and the shares are gathered.
 pub fn face_compliance(world: &SimpleCommunicator, mesh: &Mesh, nu: f64, traction: f64, cols: &[u32]) -> Result<Compliance> {
     let t0 = std::time::Instant::now();
     let rows: Vec<u32> = mesh.contact_nodes.clone();
     let (nr, nc) = (rows.len(), cols.len());
-    let mut c = vec![0.0; nr * nc];
     let part = partition(mesh, 1);
     let dofs = DofMap::new(mesh, &part, 1);
+    let mut s = vec![0.0; nr * nr];
     let mut status: i32 = 0;
     if world.rank() == 0 {
-        let r = schur_compliance(mesh, &part, &dofs, nu, traction, &rows, cols);
-        match r {
-            Ok(v) => c = v,
+        match schur_complement(mesh, &part, &dofs, nu, &rows) {
+            Ok(v) => s = v,
             Err(e) => {
                 status = 1;
                 eprintln!("ehl-petsc: face condensation failed on rank 0: {e}");
@@ -166,16 +169,78 @@ pub fn face_compliance(world: &SimpleCommunicator, mesh: &Mesh, nu: f64, tractio
     if status != 0 {
         return Err(rust_error("static condensation of the elastic block failed on rank 0 (see its message)"));
     }
-    world.process_at_rank(0).broadcast_into(&mut c[..]);
+    world.process_at_rank(0).broadcast_into(&mut s[..]);
+    let dbg = std::env::var_os("EHL_DEBUG").is_some();
+    if dbg && world.rank() == 0 {
+        eprintln!("condense: S on every rank {:.2} s", t0.elapsed().as_secs_f64());
+    }
+    // This rank's columns: equal blocks, the last rank the remainder.
+    let size = world.size() as usize;
+    let chunk = nc.div_ceil(size);
+    let span = |r: usize| ((r * chunk).min(nc), ((r + 1) * chunk).min(nc));
+    let (c0, c1) = span(world.rank() as usize);
+    let mine = solve_columns(&mut s, nr, &face_mass(mesh, &rows, &cols[c0..c1]), traction)?;
+    drop(s);
+    // Gather the column blocks (column-major, nr x block) and store C row-major.
+    let counts: Vec<i32> = (0..size).map(|r| ((span(r).1 - span(r).0) * nr) as i32).collect();
+    let displs: Vec<i32> = counts.iter().scan(0, |acc, &n| Some(std::mem::replace(acc, *acc + n))).collect();
+    let mut xcol = vec![0.0; nr * nc];
+    {
+        let mut part = mpi::datatype::PartitionMut::new(&mut xcol[..], &counts[..], &displs[..]);
+        world.all_gather_varcount_into(&mine[..], &mut part);
+    }
+    let mut c = vec![0.0; nr * nc];
+    for (j, col) in xcol.chunks_exact(nr).enumerate() {
+        for (i, &v) in col.iter().enumerate() {
+            c[i * nc + j] = v;
+        }
+    }
+    if dbg && world.rank() == 0 {
+        eprintln!("condense: compliance on every rank {:.2} s", t0.elapsed().as_secs_f64());
+    }
     Ok(Compliance { rows, cols: cols.to_vec(), c, seconds: t0.elapsed().as_secs_f64(), elastic_unknowns: dofs.total() })
+}
+
+/// X = -c S^{-1} M for the face mass block `m` (row-major, nr x k): dense Cholesky of S
+/// (overwritten by its factor) and a solve with k right-hand sides; X column-major.
+fn solve_columns(s: &mut [f64], nr: usize, m: &[f64], traction: f64) -> Result<Vec<f64>> {
+    let selfc = unsafe { ffi::RSMPI_COMM_SELF };
+    let k = m.len() / nr.max(1);
+    let mut bcol = vec![0.0; nr * k];
+    for i in 0..nr {
+        for j in 0..k {
+            bcol[j * nr + i] = -traction * m[i * k + j];
+        }
+    }
+    let mut x = vec![0.0; nr * k];
+    if k == 0 {
+        return Ok(x);
+    }
+    let mut sm = OwnedMat(std::ptr::null_mut());
+    pcall!(ffi::MatCreateSeqDense(selfc, nr as i32, nr as i32, s.as_mut_ptr(), &mut sm.0))?;
+    let mut b = OwnedMat(std::ptr::null_mut());
+    pcall!(ffi::MatCreateSeqDense(selfc, nr as i32, k as i32, bcol.as_mut_ptr(), &mut b.0))?;
+    let mut xm = OwnedMat(std::ptr::null_mut());
+    pcall!(ffi::MatCreateSeqDense(selfc, nr as i32, k as i32, x.as_mut_ptr(), &mut xm.0))?;
+    let mut info: ffi::MatFactorInfo = unsafe { std::mem::zeroed() };
+    pcall!(ffi::MatFactorInfoInitialize(&mut info))?;
+    // SPD: LAPACK potrf/potrs (without the flag PETSc takes the indefinite sytrf path).
+    pcall!(ffi::MatSetOption(sm.0, ffi::MatOption_MAT_SPD, ffi::PetscBool_PETSC_TRUE))?;
+    pcall!(ffi::MatCholeskyFactor(sm.0, std::ptr::null_mut(), &info))?;
+    pcall!(ffi::MatMatSolve(sm.0, b.0, xm.0))?;
+    // The matrices wrap the Rust buffers: destroy them before the buffers move.
+    drop(xm);
+    drop(b);
+    drop(sm);
+    Ok(x)
 }
 
 /// Options prefix of the elastic factorisation of the condensation (`-elastic_mat_mumps_...`).
 pub const ELASTIC_PREFIX: &std::ffi::CStr = c"elastic_";
 
-/// Rank 0's work: K on PETSC_COMM_SELF, MUMPS LU with the Schur complement on the face
-/// U_y unknowns, then C = -c S^{-1} M by a dense LAPACK solve.
-fn schur_compliance(mesh: &Mesh, part: &crate::mesh::Partition, dofs: &DofMap, nu: f64, traction: f64, rows: &[u32], cols: &[u32]) -> Result<Vec<f64>> {
+/// Rank 0's work: K on PETSC_COMM_SELF, MUMPS Cholesky with the Schur complement S on the
+/// face U_y unknowns (dense nr x nr, symmetric: row- and column-major alike).
+fn schur_complement(mesh: &Mesh, part: &crate::mesh::Partition, dofs: &DofMap, nu: f64, rows: &[u32]) -> Result<Vec<f64>> {
     let selfc = unsafe { ffi::RSMPI_COMM_SELF };
     let t = std::time::Instant::now();
     let k = assemble_stiffness(selfc, mesh, part, dofs, 0, nu)?;
@@ -208,32 +273,13 @@ fn schur_compliance(mesh: &Mesh, part: &crate::mesh::Partition, dofs: &DofMap, n
     if dbg { eprintln!("condense: factor + Schur {:.2} s", t.elapsed().as_secs_f64()); }
     drop(f);
     drop(k);
-    // B = -c M (column-major for PETSc's dense matrix), then solve S X = B in place.
-    let m = face_mass(mesh, rows, cols);
-    let nc = cols.len();
-    let mut bcol = vec![0.0; nr * nc];
-    for i in 0..nr {
-        for j in 0..nc {
-            bcol[j * nr + i] = -traction * m[i * nc + j];
-        }
-    }
-    let mut b = OwnedMat(std::ptr::null_mut());
-    pcall!(ffi::MatCreateSeqDense(selfc, nr as i32, nc as i32, bcol.as_mut_ptr(), &mut b.0))?;
-    let mut x = OwnedMat(std::ptr::null_mut());
-    pcall!(ffi::MatCreateSeqDense(selfc, nr as i32, nc as i32, std::ptr::null_mut(), &mut x.0))?;
-    pcall!(ffi::MatLUFactor(s.0, std::ptr::null_mut(), std::ptr::null_mut(), &info))?;
-    pcall!(ffi::MatMatSolve(s.0, b.0, x.0))?;
+    let mut lda: ffi::PetscInt = 0;
+    pcall!(ffi::MatDenseGetLDA(s.0, &mut lda))?;
+    let lda = lda as usize;
     let mut ptr: *const f64 = std::ptr::null();
-    pcall!(ffi::MatDenseGetArrayRead(x.0, &mut ptr))?;
-    let xs = unsafe { std::slice::from_raw_parts(ptr, nr * nc) };
-    let mut c = vec![0.0; nr * nc];
-    for i in 0..nr {
-        for j in 0..nc {
-            c[i * nc + j] = xs[j * nr + i];
-        }
-    }
-    pcall!(ffi::MatDenseRestoreArrayRead(x.0, &mut ptr))?;
-    if dbg { eprintln!("condense: dense solve {:.2} s", t.elapsed().as_secs_f64()); }
-    drop(b); // bcol outlives b
-    Ok(c)
+    pcall!(ffi::MatDenseGetArrayRead(s.0, &mut ptr))?;
+    let a = unsafe { std::slice::from_raw_parts(ptr, lda * nr) };
+    let out = (0..nr).flat_map(|j| a[j * lda..j * lda + nr].iter().copied()).collect();
+    pcall!(ffi::MatDenseRestoreArrayRead(s.0, &mut ptr))?;
+    Ok(out)
 }
