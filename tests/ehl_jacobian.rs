@@ -31,12 +31,16 @@ fn ehl_jacobian_matches_finite_differences() {
 /// Runs the coarse Table 2 scene for a few Newton iterations and returns the SNES residual
 /// norms it printed (the whole continuation path).
 fn newton_norms(tag: &str, monolithic: bool) -> Vec<f64> {
+    newton_norms_on(tag, monolithic, 2)
+}
+
+fn newton_norms_on(tag: &str, monolithic: bool, ranks: usize) -> Vec<f64> {
     let dir = scratch(tag);
     let scene = table2_ue2_with_mesh("contact_size = 1.0\ngrowth = 2.0");
     let path = write_scene(&dir, "scene.toml", &scene);
     let mut cmd = std::process::Command::new("mpirun");
-    cmd.args(["-n", "2"]).arg(binary()).args([path.as_str(), "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "3", "-snes_monitor"]);
-    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OPENBLAS_NUM_THREADS", "1");
+    cmd.args(["-n", &ranks.to_string()]).arg(binary()).args([path.as_str(), "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "3", "-snes_monitor"]);
+    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OMPI_MCA_rmaps_base_oversubscribe", "1").env("OPENBLAS_NUM_THREADS", "1");
     if monolithic {
         cmd.env("EHL_MONOLITHIC", "1");
     }
@@ -59,5 +63,22 @@ fn condensed_newton_matches_monolithic_newton() {
     for k in 0..4 {
         let rel = (c[k] - m[k]).abs() / m[k].abs();
         assert!(rel < 1e-6, "iteration {k}: condensed {} vs monolithic {} (rel {rel:.2e})\n{c:?}\n{m:?}", c[k], m[k]);
+    }
+}
+
+/// The dense condensed Jacobian is filled block by block where it is stored: all of it on
+/// 1 rank (LAPACK LU), column blocks on 2 ranks (a 1 x 2 ScaLAPACK grid), row and column
+/// blocks on 4 (2 x 2). A block filled wrongly changes the Newton steps: the residual
+/// history from the same start must agree to round-off at 1, 2 and 4 ranks.
+#[test]
+fn condensed_newton_history_is_rank_invariant() {
+    let one = newton_norms_on("ehl-condensed-1", false, 1);
+    assert!(one.len() >= 4, "too few Newton iterations printed: {one:?}");
+    for ranks in [2, 4] {
+        let other = newton_norms_on(&format!("ehl-condensed-{ranks}"), false, ranks);
+        for k in 0..4 {
+            let rel = (other[k] - one[k]).abs() / one[k].abs();
+            assert!(rel < 1e-8, "{ranks} ranks, iteration {k}: {} vs {} on 1 rank (rel {rel:.2e})\n{other:?}\n{one:?}", other[k], one[k]);
+        }
     }
 }
