@@ -6,7 +6,9 @@ const AFTER_HELP: &str = "\
 PETSc options follow the scene file and go to PETSc unchanged (PETSC_OPTIONS works too):
   mpirun -n 2 ehl-petsc cases/dry-hertz.toml -ksp_view -log_view
   ehl-petsc cases/dry-hertz.toml -pc_type gamg -ksp_type cg -ksp_rtol 1e-10
-Defaults: -ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps -mat_mumps_icntl_7 4 (PORD).
+Defaults: -ksp_type preonly -pc_type lu; MUMPS (-mat_mumps_icntl_7 4, PORD) for sparse matrices;
+  the dense condensed EHL Jacobian: -pc_factor_mat_solver_type scalapack (2+ ranks) or petsc
+  (LAPACK, 1 rank); -condensed_mat_type aij -pc_factor_mat_solver_type mumps returns to MUMPS.
 Useful: -log_view, -ksp_view, -options_left (lists options nobody used), -mat_mumps_icntl_4 2.
 Exit codes: 0 success, 1 solve failed or did not converge, 2 bad scene or output folder, 3 PETSc start-up,
   130/143 interrupted by SIGINT/SIGTERM (all ranks stop at the next check; no result of the
