@@ -65,34 +65,19 @@ impl Matrix {
     /// Adds a dense block `vals` (row-major, rows.len() x cols.len()) at global indices.
     /// Negative indices are ignored by PETSc (used for eliminated Dirichlet dofs).
     pub fn add_values(&self, rows: &[i32], cols: &[i32], vals: &[f64]) -> Result<()> {
-        if vals.len() != rows.len() * cols.len() {
-            return Err(rust_error("Matrix::add_values: block size mismatch"));
-        }
-        pcall!(ffi::MatSetValues(
-            self.raw,
-            rows.len() as ffi::PetscInt,
-            rows.as_ptr(),
-            cols.len() as ffi::PetscInt,
-            cols.as_ptr(),
-            vals.as_ptr(),
-            ffi::InsertMode_ADD_VALUES
-        ))
+        self.put_values(rows, cols, vals, ffi::InsertMode_ADD_VALUES, "add_values")
     }
 
     /// Sets (overwrites) a dense block `vals` (row-major, rows.len() x cols.len()).
     pub fn set_values(&self, rows: &[i32], cols: &[i32], vals: &[f64]) -> Result<()> {
+        self.put_values(rows, cols, vals, ffi::InsertMode_INSERT_VALUES, "set_values")
+    }
+
+    fn put_values(&self, rows: &[i32], cols: &[i32], vals: &[f64], mode: ffi::InsertMode, what: &str) -> Result<()> {
         if vals.len() != rows.len() * cols.len() {
-            return Err(rust_error("Matrix::set_values: block size mismatch"));
+            return Err(rust_error(format!("Matrix::{what}: block size mismatch")));
         }
-        pcall!(ffi::MatSetValues(
-            self.raw,
-            rows.len() as ffi::PetscInt,
-            rows.as_ptr(),
-            cols.len() as ffi::PetscInt,
-            cols.as_ptr(),
-            vals.as_ptr(),
-            ffi::InsertMode_INSERT_VALUES
-        ))
+        pcall!(ffi::MatSetValues(self.raw, rows.len() as ffi::PetscInt, rows.as_ptr(), cols.len() as ffi::PetscInt, cols.as_ptr(), vals.as_ptr(), mode))
     }
 
     /// The (rows, columns) block of a dense matrix whose entries this rank stores: for
