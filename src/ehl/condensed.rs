@@ -391,8 +391,8 @@ impl EhlProblem for CondensedSystem<'_> {
         true
     }
 
-    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant) {
-        self.params.lambda_bar = lambda_bar;
+    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64) {
+        self.params.set_operating(lambda_bar, penalty);
         self.lubricant = lubricant;
     }
 

@@ -72,6 +72,16 @@ pub struct EhlParams {
     pub nu: f64,
 }
 
+impl EhlParams {
+    /// A new operating point: the speed parameter and the cavitation penalty (which the
+    /// SUPG strong residual carries too).
+    pub fn set_operating(&mut self, lambda_bar: f64, penalty: f64) {
+        self.lambda_bar = lambda_bar;
+        self.penalty = penalty;
+        self.stabilisation.penalty = penalty;
+    }
+}
+
 /// One contact triangle as the Reynolds assembly sees it.
 struct ContactElement {
     nodes: [u32; 6],
@@ -246,7 +256,8 @@ pub trait EhlProblem: Problem {
     /// Changes the operating point seen by the Reynolds rows (for continuation): the
     /// speed parameter lambda_bar and the dimensionless lubricant laws. The elastic rows do
     /// not depend on it.
-    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant);
+    /// The cavitation penalty xi enters the penalty rows and the SUPG strong residual.
+    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64);
     /// Scales each Reynolds row by the inverse of its Jacobian diagonal at `x` (held constant
     /// afterwards, so the Jacobian stays exact and the solution unchanged). The rows' natural
     /// sizes differ by ten orders of magnitude (eps ~ 1e4 at the inlet, ~1e-9 in the
@@ -266,8 +277,8 @@ pub trait EhlProblem: Problem {
 }
 
 impl EhlProblem for EhlSystem<'_> {
-    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant) {
-        self.params.lambda_bar = lambda_bar;
+    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64) {
+        self.params.set_operating(lambda_bar, penalty);
         self.lubricant = lubricant;
     }
 
@@ -458,5 +469,19 @@ impl Problem for EhlSystem<'_> {
         }
         self.jacobian_built = true;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The penalty continuation changes xi between solves: the penalty rows and the SUPG
+    /// strong residual must see the same xi, or SUPG is inconsistent in the cavitated zone.
+    #[test]
+    fn set_operating_moves_the_penalty_of_rows_and_supg_together() {
+        let mut p = EhlParams { lambda_bar: 1e-3, traction: 1.0, load: 1.0, penalty: 1e4, stabilisation: Stabilisation { penalty: 1e4, ..Default::default() }, velocity: Box::new(|_, _| [1.0, 0.0]), nu: 0.3 };
+        p.set_operating(2e-3, 1e3);
+        assert_eq!((p.lambda_bar, p.penalty, p.stabilisation.penalty), (2e-3, 1e3, 1e3));
     }
 }
