@@ -37,11 +37,9 @@ impl CondensedLayout {
         for (i, &n) in comp.rows.iter().enumerate() {
             face_index[n as usize] = i as i32;
         }
-        // Equal blocks of ceil(total / nranks) rows, the last rank the remainder: the row
-        // layout the dense ScaLAPACK Jacobian requires.
-        let total = n_p + 1;
-        let chunk = total.div_ceil(nranks);
-        let ranges = (0..=nranks).map(|r| (r * chunk).min(total)).collect();
+        // Equal blocks, the last rank the remainder: the row layout the dense ScaLAPACK
+        // Jacobian requires.
+        let ranges = crate::mesh::equal_blocks(n_p + 1, nranks);
         CondensedLayout { n_p, ranges, p_index, face_index }
     }
     pub fn total(&self) -> usize {
@@ -96,6 +94,20 @@ impl FillBlock {
         // The H0 column has no compliance: 0 in the restricted copy.
         let c_cols = (!all && !comp.is_rigid()).then(|| comp.c.chunks_exact(np).flat_map(|crow| cols.iter().map(|&c| if c < np { crow[c] } else { 0.0 })).collect());
         FillBlock { rows, cols, row_pos, col_pos, c_cols }
+    }
+
+    /// Position in the block of row `d` (None: -1, or not in the block).
+    fn row_of(&self, d: i32) -> Option<usize> {
+        Self::pos(&self.row_pos, d)
+    }
+
+    /// Position in the block of column `d` (None: -1, or not in the block).
+    fn col_of(&self, d: i32) -> Option<usize> {
+        Self::pos(&self.col_pos, d)
+    }
+
+    fn pos(table: &[i32], d: i32) -> Option<usize> {
+        (d >= 0 && table[d as usize] >= 0).then(|| table[d as usize] as usize)
     }
 
     /// Compliance row of face node `f` on the block's columns (with every column, the P
@@ -531,23 +543,20 @@ impl Problem for CondensedSystem<'_> {
         let fb = &self.fill;
         let ncl = fb.cols.len();
         let mut buf = vec![0.0; fb.rows.len() * ncl];
-        let h0_col = fb.col_pos[np];
+        let h0_col = fb.col_of(np as i32);
         for e in &self.elements {
-            if !e.p.iter().any(|&d| d >= 0 && fb.row_pos[d as usize] >= 0) {
+            if !e.p.iter().any(|&d| fb.row_of(d).is_some()) {
                 continue;
             }
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
             let out = self.eval(e, &p, &he, &fluid);
             for i in 0..6 {
-                if e.p[i] < 0 || fb.row_pos[e.p[i] as usize] < 0 {
-                    continue;
-                }
-                let l = fb.row_pos[e.p[i] as usize] as usize;
+                let Some(l) = fb.row_of(e.p[i]) else { continue };
                 let row = &mut buf[l * ncl..(l + 1) * ncl];
                 for k in 0..6 {
-                    if e.p[k] >= 0 && fb.col_pos[e.p[k] as usize] >= 0 {
-                        row[fb.col_pos[e.p[k] as usize] as usize] += out.dr_dp[i][k];
+                    if let Some(c) = fb.col_of(e.p[k]) {
+                        row[c] += out.dr_dp[i][k];
                     }
                     // H = H0 + gap - U_y with U_y = C P: dH/dP = -C, dH/dH0 = 1.
                     let g = out.dr_dh[i][k];
@@ -557,8 +566,8 @@ impl Problem for CondensedSystem<'_> {
                                 *a -= g * c;
                             }
                         }
-                        if h0_col >= 0 {
-                            row[h0_col as usize] += g;
+                        if let Some(c) = h0_col {
+                            row[c] += g;
                         }
                     }
                 }
@@ -567,36 +576,36 @@ impl Problem for CondensedSystem<'_> {
         for (l, &jn) in fb.rows.iter().enumerate().filter(|(_, &r)| r < np) {
             let row = &mut buf[l * ncl..(l + 1) * ncl];
             let area = self.p_area[jn];
-            if fb.col_pos[jn] >= 0 {
-                row[fb.col_pos[jn] as usize] += self.params.penalty * area * penalty_slope(x[jn]);
+            let diag = fb.col_of(jn as i32);
+            if let Some(c) = diag {
+                row[c] += self.params.penalty * area * penalty_slope(x[jn]);
             }
             if let Some((dt, _)) = &self.pseudo {
                 let f = self.p_face[jn];
                 let (rho, drho) = (self.lubricant.rho)(x[jn]);
                 // d(rho H)/dP_k = rho' H delta_jk - rho C[f, k]; d/dH0 = rho.
-                if fb.col_pos[jn] >= 0 {
-                    row[fb.col_pos[jn] as usize] += area * drho * h[f] / dt;
+                if let Some(c) = diag {
+                    row[c] += area * drho * h[f] / dt;
                 }
                 if !self.comp.is_rigid() {
                     for (a, c) in row.iter_mut().zip(fb.c_row(self.comp, f)) {
                         *a -= area * rho * c / dt;
                     }
                 }
-                if h0_col >= 0 {
-                    row[h0_col as usize] += area * rho / dt;
+                if let Some(c) = h0_col {
+                    row[c] += area * rho / dt;
                 }
             }
             let s = self.row_scale[jn];
             row.iter_mut().for_each(|v| *v *= s);
         }
-        if fb.row_pos[np] >= 0 {
+        if let Some(l) = fb.row_of(np as i32) {
             // Load row: integral of P.
-            let l = fb.row_pos[np] as usize;
             let row = &mut buf[l * ncl..(l + 1) * ncl];
             for e in &self.elements {
                 for k in 0..6 {
-                    if e.p[k] >= 0 && fb.col_pos[e.p[k] as usize] >= 0 {
-                        row[fb.col_pos[e.p[k] as usize] as usize] += e.w[k];
+                    if let Some(c) = fb.col_of(e.p[k]) {
+                        row[c] += e.w[k];
                     }
                 }
             }

@@ -238,11 +238,12 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
     EhlSolver::new(ctx, scene, mesh, part, dofs, layout, half)?.solve(ctx, scene, None)
 }
 
-/// The condensed path: Newton on (P, H0) with the face compliance `comp`, from the Hertz
-/// start or from a previous state `start` (monolithic layout).
 /// Options prefix of the condensed Newton Jacobian (`-condensed_mat_type aij` with
 /// `-pc_factor_mat_solver_type mumps` returns to the sparse-format MUMPS LU).
 pub const CONDENSED_PREFIX: &std::ffi::CStr = c"condensed_";
+
+/// The condensed path: Newton on (P, H0) with the face compliance `comp`, from the Hertz
+/// start or from a previous state `start` (monolithic layout).
 
 fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, comp: &crate::solid::condense::Compliance, half: bool, start: Option<&[f64]>) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();

@@ -28,7 +28,7 @@ pub mod face;
 mod tests;
 
 pub use locate::ContactLocator;
-pub use partition::{morton3, partition, Partition};
+pub use partition::{equal_blocks, morton3, partition, Partition};
 pub use quality::{quality, tet_quality, Quality};
 pub use spec::{MeshSpec, Rect, Ring};
 

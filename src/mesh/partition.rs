@@ -55,6 +55,14 @@ pub fn morton_order(mesh: &Mesh) -> Vec<u32> {
     sorted_by_key(&keys)
 }
 
+/// Split `n` items over `parts` in equal blocks of ceil(n / parts), the last the remainder
+/// (later parts may be empty): block r is `b[r]..b[r + 1]` of the returned `parts + 1`
+/// bounds. The layout ScaLAPACK's block-cyclic matrices require of the ranks' rows.
+pub fn equal_blocks(n: usize, parts: usize) -> Vec<usize> {
+    let chunk = n.div_ceil(parts);
+    (0..=parts).map(|r| (r * chunk).min(n)).collect()
+}
+
 /// Splits the mesh into `nranks` parts: tets ordered along the Morton curve
 /// of their centroids and cut into contiguous chunks of equal size (within
 /// one); nodes owned by the lowest rank touching them. Pure function of the
@@ -93,6 +101,14 @@ pub fn partition(mesh: &Mesh, nranks: usize) -> Partition {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn equal_blocks_are_ceil_sized_with_the_remainder_last() {
+        assert_eq!(equal_blocks(10, 4), vec![0, 3, 6, 9, 10]);
+        assert_eq!(equal_blocks(3237, 2), vec![0, 1619, 3237]);
+        assert_eq!(equal_blocks(5, 4), vec![0, 2, 4, 5, 5]);
+        assert_eq!(equal_blocks(7, 1), vec![0, 7]);
+    }
 
     #[test]
     fn morton_interleaves_bits() {

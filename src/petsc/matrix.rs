@@ -32,7 +32,8 @@ impl Matrix {
     /// A square dense matrix with `local_rows` rows on this rank, for a Jacobian that is
     /// dense by nature (the condensed EHL system). One rank: `MATSEQDENSE`, factorised by
     /// LAPACK (PETSc's own LU); several: `MATSCALAPACK` (2D block-cyclic, factorised by
-    /// ScaLAPACK; rows set by their PETSc owner travel through the stash at assembly).
+    /// ScaLAPACK; entries set off the rank that stores them travel through the stash at
+    /// assembly, see [`Matrix::dense_fill_block`]).
     /// `MatSetFromOptions` with the prefix `prefix` lets the user pick another type
     /// (`-{prefix}mat_type aij` and a sparse direct solver); for a sparse type the
     /// preallocation `d_nnz`, `o_nnz` applies.

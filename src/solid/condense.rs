@@ -176,8 +176,8 @@ pub fn face_compliance(world: &SimpleCommunicator, mesh: &Mesh, nu: f64, tractio
     }
     // This rank's columns: equal blocks, the last rank the remainder.
     let size = world.size() as usize;
-    let chunk = nc.div_ceil(size);
-    let span = |r: usize| ((r * chunk).min(nc), ((r + 1) * chunk).min(nc));
+    let blocks = crate::mesh::equal_blocks(nc, size);
+    let span = |r: usize| (blocks[r], blocks[r + 1]);
     let (c0, c1) = span(world.rank() as usize);
     let mine = solve_columns(&mut s, nr, &face_mass(mesh, &rows, &cols[c0..c1]), traction)?;
     drop(s);
