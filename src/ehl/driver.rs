@@ -1,6 +1,6 @@
 //! The lubricated solve: builds the coupled system, starts from the dry Hertz state,
-//! runs Newton (PETSc SNES, MUMPS LU), and falls back to an automatic continuation in
-//! load when Newton fails from the Hertz start.
+//! runs Newton (PETSc SNES; a dense LU on the condensed system), and falls back to an
+//! automatic continuation when Newton fails from the Hertz start.
 //!
 //! Developer diagnostics (environment variables, not part of the user interface):
 //! `EHL_CHECK_JACOBIAN=1` prints a block-by-block finite-difference check of the Jacobian at
@@ -443,6 +443,8 @@ struct Homotopy {
     /// First t tried from the start, halved down to `lowest` until Newton converges.
     start: f64,
     lowest: f64,
+    /// First factor on t when ramping to t = 1.
+    ratio: f64,
     apply: SceneAt,
     show: Box<dyn Fn(f64) -> String>,
     /// The parameter changes the entrainment velocity field (tilt angle).
@@ -454,9 +456,11 @@ struct Homotopy {
 /// Sets a scene's problem at continuation parameter t.
 type SceneAt = Box<dyn Fn(&mut Scene, f64)>;
 
-/// Newton from `x0` (described by `label`) at the scene's operating point; if that fails
-/// and `continuation` is set, a continuation in the tilt angle (spin), then in
-/// pressure-viscosity, then in load, then in speed, from a milder problem to the scene's (each step is logged and kept in the path).
+/// Newton from `x0` (described by `label`) at the scene's operating point. With
+/// `continuation` set, a stiff cavitation penalty (xi > 1e3) is solved at xi = 1e3 first;
+/// if that fails, a continuation in the tilt angle (spin), then in pressure-viscosity, then
+/// in load, then in speed, from a milder problem to the scene's (at xi = 1e3); and last the
+/// penalty from 1e3 to the scene's xi. Each step is logged and kept in the path.
 /// Returns the converged iterate (gathered) or an error naming the path taken.
 #[allow(clippy::too_many_arguments)]
 fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], label: &str, continuation: bool, j: &Matrix, (lo, hi): (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
@@ -473,17 +477,38 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
         }
         snes.solve(system, &x, j).map_err(pe)
     };
-    // 1. Plain Newton from the Hertz start at the scene's operating point.
+    // The problem solved first. A stiff cavitation penalty (xi > 1e3) is reached last, from
+    // the solution at xi = 1e3: on fine rings Newton crawls at xi = 1e4 from the Hertz start
+    // (each step flips nodes across the penalty's kink; 30 iterations wasted on table2-ue2
+    // with the ring halved), while from the xi = 1e3 solution the cavitated set is already
+    // right. Every other continuation runs at xi = 1e3 too, where Newton converges from the
+    // Hertz start on every mesh measured (README "The cavitation penalty and the finer ring").
+    // A warm start (no continuation) goes straight to the scene's xi.
     let target = scene.operating.load;
+    let xi = penalty(scene);
+    let staged = continuation && xi > PENALTY_START;
+    let mut base = scene.clone();
+    if staged {
+        base.reynolds.penalty = PENALTY_START;
+    }
+    // 1. Plain Newton from the Hertz start at the base problem.
     let report = if std::env::var_os("EHL_SKIP_PLAIN").is_some() {
         SolveReport { converged: false, reason: "SKIPPED".into(), reason_code: 0, iterations: 0, linear_iterations: 0, residual_norm: f64::NAN, domain_error: None }
     } else {
-        solve_scene(scene, system, x0)?
+        solve_scene(&base, system, x0)?
     };
-    let mut steps = vec![format!("Newton from {label} at L = {} N: {} ({} iterations)", target, report.reason, report.iterations)];
-    ctx.log(&steps[0]);
-    let mut newton_total = report.iterations;
+    let at_xi = if staged { format!(", xi = {PENALTY_START:e}") } else { String::new() };
+    // The path taken: every Newton solve, logged as it ends.
+    let steps = std::cell::RefCell::new(Vec::new());
+    let note = |s: String| {
+        ctx.log(&s);
+        steps.borrow_mut().push(s);
+    };
+    note(format!("Newton from {label} at L = {target} N{at_xi}: {} ({} iterations)", report.reason, report.iterations));
+    let newton_total = std::cell::Cell::new(report.iterations);
     let mut last = report;
+    // The converged state of the base problem.
+    let mut state: Option<Vec<f64>> = if last.converged { Some(x.gather_all().map_err(pe)?) } else { None };
     // 2. Experimental (developer switch EHL_PTC, condensed path only): pseudo-transient
     //    continuation from the same start: implicit pseudo-time steps of the transient Reynolds equation, the
     //    step growing as the steady residual falls (switched evolution relaxation), then
@@ -500,9 +525,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
             f.norm2().map_err(pe)
         };
         if std::env::var_os("EHL_PTC").is_some() && system.set_pseudo_time(None, x0) {
-            let mut sc = scene.clone();
-            sc.operating.load = target;
-            system.set_operating(lambda_bar(&sc), lubricant(&sc), penalty(&sc));
+            system.set_operating(lambda_bar(&base), lubricant(&base), penalty(&base));
             if scaling {
                 system.scale_rows(x0).map_err(pe)?;
             }
@@ -537,51 +560,86 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
                 }
             }
             system.set_pseudo_time(None, &xk);
-            newton_total += its;
-            steps.push(format!("pseudo-transient continuation: {n_steps} pseudo-time steps ({its} iterations), steady residual {:.2e} of the start's{}", fk / f_start, if ok { "" } else { " (gave up)" }));
-            ctx.log(steps.last().unwrap());
-            let r = solve_scene(scene, system, &xk)?;
-            newton_total += r.iterations;
-            steps.push(format!("Newton on the steady problem: {} ({} iterations)", r.reason, r.iterations));
-            ctx.log(steps.last().unwrap());
+            newton_total.set(newton_total.get() + its);
+            note(format!("pseudo-transient continuation: {n_steps} pseudo-time steps ({its} iterations), steady residual {:.2e} of the start's{}", fk / f_start, if ok { "" } else { " (gave up)" }));
+            let r = solve_scene(&base, system, &xk)?;
+            newton_total.set(newton_total.get() + r.iterations);
+            note(format!("Newton on the steady problem: {} ({} iterations)", r.reason, r.iterations));
+            if r.converged {
+                state = Some(x.gather_all().map_err(pe)?);
+            }
             last = r;
         }
     }
+    // One Newton solve of `sc0` changed by homotopy `h` at t, from `start`; the step is
+    // logged and kept in the path. Returns the report and, if converged, the state.
+    let solve_h = |sc0: &Scene, h: &Homotopy, t: f64, system: &mut dyn EhlProblem, start: &[f64], what: String| -> Result<(SolveReport, Option<Vec<f64>>), String> {
+        crate::interrupt::check("the continuation")?;
+        let mut sc = sc0.clone();
+        (h.apply)(&mut sc, t);
+        if h.kinematic {
+            system.set_velocity(velocity_field(&sc));
+        }
+        let r = solve_scene(&sc, system, start)?;
+        newton_total.set(newton_total.get() + r.iterations);
+        note(format!("{} continuation: {what}{}: {} ({} iterations)", h.name, (h.show)(t), r.reason, r.iterations));
+        let xs = if r.converged { Some(x.gather_all().map_err(pe)?) } else { None };
+        Ok((r, xs))
+    };
+    // Ramps `h` from t (where `state` is converged) to the scene's problem at t = 1,
+    // multiplying t by `h.ratio`, by its square root after each failure, and giving up below
+    // a ratio of 1.05. Returns whether t = 1 converged, the last report and the last
+    // converged state.
+    let ramp = |solve_h: &dyn Fn(&Scene, &Homotopy, f64, &mut dyn EhlProblem, &[f64], String) -> Result<(SolveReport, Option<Vec<f64>>), String>,
+                sc0: &Scene,
+                h: &Homotopy,
+                mut t: f64,
+                mut state: Vec<f64>,
+                system: &mut dyn EhlProblem|
+     -> Result<(bool, Option<SolveReport>, Vec<f64>), String> {
+        let mut ratio = h.ratio;
+        let mut last = None;
+        while t < 1.0 {
+            let next = (t * ratio).min(1.0);
+            let (r, xs) = solve_h(sc0, h, next, system, &state, String::new())?;
+            match xs {
+                Some(xs) => {
+                    state = xs;
+                    t = next;
+                }
+                None => {
+                    ratio = ratio.sqrt();
+                    if ratio < 1.05 {
+                        return Ok((false, Some(r), state));
+                    }
+                }
+            }
+            last = Some(r);
+        }
+        Ok((true, last, state))
+    };
     // 3. If it failed: continuation, first (spin kinematics, lambda < 90 deg) in the tilt
     //    angle, then in pressure-viscosity, then in load, then in speed. Each is a milder
     //    problem at one end (a larger tilt: weaker spin; a smaller alpha: a less steep
     //    viscosity at the same Hertz geometry, so the Hertz start stays good; a lighter
     //    load in Hertz units: smaller M and alpha p_H; a higher speed: a thicker film) and
-    //    the scene's at the other; each converged state starts the next. Pressure-viscosity
+    //    the base problem at the other; each converged state starts the next. Pressure-viscosity
     //    goes before load: on the hard suite it is the one that converges (alpha30 on the
     //    paper mesh: load continuation fails from every Hertz start down to L/64, alpha/2 ->
     //    alpha converges in 23 + 8 iterations); the tilt only applies to spin scenes.
-    //    Before all of them, a stiff cavitation penalty (xi > 1e3) is raised from 1e3 (one
-    //    try): on fine rings Newton crawls at xi = 1e4 from the Hertz start, where each step
-    //    flips nodes across the penalty's kink; from the xi = 1e3 solution the cavitated
-    //    set is already right. It is the cheapest change of problem, so it goes first.
-    if !last.converged && continuation {
+    if state.is_none() && continuation {
         let alpha = scene.lubricant.as_ref().and_then(|l| l.pressure_viscosity).unwrap_or(0.0);
         let z = scene.lubricant.as_ref().and_then(|l| l.roelands_exponent);
         let ue = scene.operating.entrainment_speed.unwrap_or(0.0);
         let tilt = scene.operating.tilt_angle;
-        let xi = penalty(scene);
         // A small tilt angle (strong spin) is milder at a larger one; only with spin kinematics.
         let spin = scene.effects.kinematics == crate::case::KinematicsModel::Spin && tilt < 90.0;
         let homotopies: Vec<Homotopy> = vec![
             Homotopy {
-                name: "penalty",
-                start: PENALTY_START / xi,
-                lowest: PENALTY_START / xi,
-                apply: Box::new(move |sc: &mut Scene, t| sc.reynolds.penalty = xi * t),
-                show: Box::new(move |t| format!("xi = {:.4e}", xi * t)),
-                kinematic: false,
-                applies: xi > PENALTY_START,
-            },
-            Homotopy {
                 name: "tilt",
                 start: 0.5,
                 lowest: 1.0 / 64.0,
+                ratio: 2.0,
                 apply: Box::new(move |sc: &mut Scene, t| sc.operating.tilt_angle = (tilt / t).min(90.0)),
                 show: Box::new(move |t| format!("lambda = {:.4} deg", (tilt / t).min(90.0))),
                 kinematic: true,
@@ -591,6 +649,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
                 name: "pressure-viscosity",
                 start: 0.5,
                 lowest: 0.125,
+                ratio: 2.0,
                 apply: Box::new(move |sc: &mut Scene, t| {
                     if let Some(l) = sc.lubricant.as_mut() {
                         l.pressure_viscosity = l.pressure_viscosity.map(|_| alpha * t);
@@ -601,82 +660,75 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
                 kinematic: false,
                 applies: alpha > 0.0,
             },
-            Homotopy { name: "load", start: 1.0 / 8.0, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.load = target * t), show: Box::new(move |t| format!("L = {:.4} N", target * t)), kinematic: false, applies: true },
-            Homotopy { name: "speed", start: 0.25, lowest: 1.0 / 64.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.entrainment_speed = Some(ue / t)), show: Box::new(move |t| format!("Ue = {:.4} m/s", ue / t)), kinematic: false, applies: true },
+            Homotopy { name: "load", start: 1.0 / 8.0, lowest: 1.0 / 64.0, ratio: 2.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.load = target * t), show: Box::new(move |t| format!("L = {:.4} N", target * t)), kinematic: false, applies: true },
+            Homotopy { name: "speed", start: 0.25, lowest: 1.0 / 64.0, ratio: 2.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.entrainment_speed = Some(ue / t)), show: Box::new(move |t| format!("Ue = {:.4} m/s", ue / t)), kinematic: false, applies: true },
         ];
         for h in &homotopies {
             // A kinematic parameter also needs a problem whose velocity field can change.
             if !h.applies || (h.kinematic && !system.set_velocity(velocity_field(scene))) {
                 continue;
             }
-            let solve_h = |t: f64, system: &mut dyn EhlProblem, start: &[f64]| {
-                let mut sc = scene.clone();
-                (h.apply)(&mut sc, t);
-                if h.kinematic {
-                    system.set_velocity(velocity_field(&sc));
-                }
-                solve_scene(&sc, system, start)
-            };
             // Find a milder problem Newton solves from the start.
             let mut t = h.start;
-            let mut state: Option<Vec<f64>> = None;
+            let mut found: Option<Vec<f64>> = None;
             while t >= h.lowest {
-                crate::interrupt::check("the continuation")?;
-                let r = solve_h(t, system, x0)?;
-                newton_total += r.iterations;
-                steps.push(format!("{} continuation: {label} at {}: {} ({} iterations)", h.name, (h.show)(t), r.reason, r.iterations));
-                ctx.log(steps.last().unwrap());
-                if r.converged {
-                    state = Some(x.gather_all().map_err(pe)?);
+                let (_, xs) = solve_h(&base, h, t, system, x0, format!("{label} at "))?;
+                if xs.is_some() {
+                    found = xs;
                     break;
                 }
                 t /= 2.0;
             }
-            let Some(mut state) = state else {
-                steps.push(format!("{} continuation: no milder problem converged down to {}", h.name, (h.show)(h.lowest)));
+            let Some(from) = found else {
+                note(format!("{} continuation: no milder problem converged down to {}", h.name, (h.show)(h.lowest)));
                 continue;
             };
-            // Ramp to the scene's problem (t = 1), halving the step ratio on failure.
-            let mut ratio: f64 = 2.0;
-            while t < 1.0 {
-                let next = (t * ratio).min(1.0);
-                let r = solve_h(next, system, &state)?;
-                newton_total += r.iterations;
-                steps.push(format!("{} continuation: {}: {} ({} iterations)", h.name, (h.show)(next), r.reason, r.iterations));
-                ctx.log(steps.last().unwrap());
-                if r.converged {
-                    state = x.gather_all().map_err(pe)?;
-                    t = next;
-                    last = r;
-                } else {
-                    ratio = ratio.sqrt();
-                    if ratio < 1.05 {
-                        last = r;
-                        break;
-                    }
-                }
+            let (done, r, xs) = ramp(&solve_h, &base, h, t, from, system)?;
+            if let Some(r) = r {
+                last = r;
             }
-            if h.kinematic && !(t >= 1.0 && last.converged) {
+            if done {
+                state = Some(xs);
+                break;
+            }
+            if h.kinematic {
                 // Back to the scene's own velocity field for what follows.
                 system.set_velocity(velocity_field(scene));
             }
-            if t >= 1.0 && last.converged {
-                break;
-            }
         }
     }
-    if !last.converged {
+    // 4. The stiff penalty: from the base solution, xi goes to the scene's in one step (its
+    //    square root, and so on, on failure). table2-ue2 with the ring halved, xi = 1e4: 11
+    //    iterations at 1e3, then 7 to 1e4 (135 s); by factors of sqrt(10): 6 + 5 (162 s);
+    //    plain Newton at 1e4 from the Hertz start: DIVERGED_MAX_IT after 30.
+    if let (Some(from), true) = (state.take(), staged) {
+        let h = Homotopy {
+            name: "penalty",
+            start: PENALTY_START / xi,
+            lowest: PENALTY_START / xi,
+            ratio: xi / PENALTY_START,
+            apply: Box::new(move |sc: &mut Scene, t| sc.reynolds.penalty = xi * t),
+            show: Box::new(move |t| format!("xi = {:.4e}", xi * t)),
+            kinematic: false,
+            applies: true,
+        };
+        let (done, r, xs) = ramp(&solve_h, scene, &h, h.start, from, system)?;
+        if let Some(r) = r {
+            last = r;
+        }
+        state = if done { Some(xs) } else { None };
+    }
+    let Some(xs) = state else {
         return Err(format!(
             "Newton did not converge: {} after {} iterations (residual norm {:.3e}){}; path: {}",
             last.reason,
             last.iterations,
             last.residual_norm,
             last.domain_error.as_ref().map(|d| format!("; last domain error: {d}")).unwrap_or_default(),
-            steps.join("; ")
+            steps.borrow().join("; ")
         ));
-    }
-    let xs = x.gather_all().map_err(pe)?;
-    Ok(NewtonOutcome { x: xs, report: last, newton_total, steps })
+    };
+    Ok(NewtonOutcome { x: xs, report: last, newton_total: newton_total.get(), steps: steps.into_inner() })
 }
 
 /// The cavitation penalty the penalty continuation starts from (Newton converges from the
