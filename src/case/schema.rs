@@ -702,11 +702,7 @@ impl Default for MeshSettings {
 impl MeshSettings {
     /// The contact element size rounded down to the form 16/2^k (units of a).
     pub fn contact_size_rounded(&self) -> f64 {
-        let mut s = 16.0;
-        while s > self.contact_size * (1.0 + 1e-12) && s > MIN_CONTACT_SIZE {
-            s *= 0.5;
-        }
-        s
+        crate::mesh::spec::dyadic_size(self.contact_size).max(MIN_CONTACT_SIZE)
     }
 }
 

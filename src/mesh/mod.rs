@@ -77,13 +77,7 @@ fn refined_bisector(spec: &MeshSpec, h: f64) -> refine::Bisector {
     let r = spec.contact;
     let (rlo, rhi) = ([r.x0, 0.0, r.z0], [r.x1, 0.0, r.z1]);
     let g = spec.growth;
-    let dyadic = |size: f64| {
-        let mut hc = spec::COARSE_CELL;
-        while hc > size * (1.0 + 1e-12) {
-            hc *= 0.5;
-        }
-        hc
-    };
+    let dyadic = spec::dyadic_size;
     let core = spec.core.map(|(c, size)| ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], dyadic(size)));
     let ring = spec.ring.map(|r| (r.inner, r.outer, dyadic(r.size)));
     b.refine_and_close(|v, t| {

@@ -9,6 +9,19 @@ pub const COARSE_CELL: f64 = 16.0;
 /// Maximum number of halvings of [`COARSE_CELL`] allowed for the contact size.
 pub const MAX_LEVEL: u32 = 20;
 
+/// The element size the mesher uses for a requested `size` (units of a): the largest
+/// 16/2^L <= size (to 1e-12 relative, so 0.0625 stays 0.0625), 0 <= L <= MAX_LEVEL. Every
+/// refinement level of the Kuhn grid halves the cell, so only these sizes exist.
+pub fn dyadic_size(size: f64) -> f64 {
+    let mut h = COARSE_CELL;
+    let mut level = 0;
+    while h > size * (1.0 + 1e-12) && level < MAX_LEVEL {
+        h *= 0.5;
+        level += 1;
+    }
+    h
+}
+
 /// Axis-aligned rectangle `[x0, x1] x [z0, z1]` on the top face `y = 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rect {
@@ -107,13 +120,7 @@ impl MeshSpec {
 
     /// Actual contact size: the largest `16 / 2^L <= contact_size` (L >= 0).
     pub fn actual_contact_size(&self) -> f64 {
-        let mut h = COARSE_CELL;
-        let mut level = 0;
-        while h > self.contact_size && level < MAX_LEVEL {
-            h *= 0.5;
-            level += 1;
-        }
-        h
+        dyadic_size(self.contact_size)
     }
 
     /// Coarse grid breakpoints along the three axes.
@@ -290,6 +297,10 @@ mod tests {
         assert_eq!(s.actual_contact_size(), 16.0);
         s.contact_size = 0.0625;
         assert_eq!(s.actual_contact_size(), 0.0625);
+        assert_eq!(dyadic_size(0.0625 * (1.0 - 1e-14)), 0.0625);
+        assert_eq!(dyadic_size(0.07), 0.0625);
+        assert_eq!(dyadic_size(100.0), 16.0);
+        assert_eq!(dyadic_size(0.0), COARSE_CELL / f64::from(1u32 << MAX_LEVEL));
     }
 
     #[test]
