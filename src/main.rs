@@ -48,6 +48,10 @@ struct Cli {
     /// mesh.ring_outer around the Hertz circle: 0.125a, 0.0625a, 0.03125a, ...)
     #[arg(long, value_name = "core|ring", default_value = "core")]
     ladder: ehl_petsc::app::study::Ladder,
+    /// The convergence study's first level size in units of a, 16/2^k (default: 0.5 for the
+    /// core ladder, 0.125 for the ring ladder); each level halves it
+    #[arg(long, value_name = "H")]
+    first_size: Option<f64>,
     /// Print the scene-file reference (every key, unit, range, default) as Markdown and exit
     #[arg(long)]
     scene_reference: bool,
@@ -85,6 +89,7 @@ fn main() {
         quiet: cli.quiet,
         study_levels: cli.convergence_study,
         ladder: cli.ladder,
+        first_size: cli.first_size,
         overrides: cli.set,
     };
     let code = ehl_petsc::app::run(world, opts);

@@ -37,6 +37,11 @@ fn convergence_study_writes_its_table_and_plots() {
     }
     // A bad level count is refused with the option named.
     let bad = mpirun(2, &["--convergence-study", "9", path.as_str(), "--output", dir.join("bad").to_str().unwrap()]);
-    assert_ne!(bad.status.code(), Some(0));
+    assert_eq!(bad.status.code(), Some(2), "{}", text(&bad));
     assert!(text(&bad).contains("--convergence-study 9"), "{}", text(&bad));
+    assert!(!dir.join("bad").exists(), "a refused study must not create its output folder");
+    // So is a first size the mesher cannot make.
+    let bad = mpirun(2, &["--convergence-study", "3", "--ladder", "ring", "--first-size", "0.1", path.as_str(), "--output", dir.join("bad").to_str().unwrap()]);
+    assert_eq!(bad.status.code(), Some(2), "{}", text(&bad));
+    assert!(text(&bad).contains("--first-size 0.1"), "{}", text(&bad));
 }

@@ -26,6 +26,8 @@ pub struct RunOptions {
     pub study_levels: Option<usize>,
     /// `--ladder`: what the convergence study refines.
     pub ladder: study::Ladder,
+    /// `--first-size`: the convergence study's first level size (default: the ladder's).
+    pub first_size: Option<f64>,
     /// `--set KEY=VALUE` scene overrides, applied before validation.
     pub overrides: Vec<String>,
 }
@@ -88,6 +90,15 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             return 2;
         }
     };
+    // A convergence study's ladder is checked with the scene (exit 2, nothing written).
+    if let Some(n) = opts.study_levels {
+        if let Err(e) = study::check_ladder(opts.ladder, opts.first_size.unwrap_or(opts.ladder.default_first()), n) {
+            if rank == 0 {
+                eprintln!("ehl-petsc: error: {e}");
+            }
+            return 2;
+        }
+    }
     if opts.check_only {
         if rank == 0 {
             println!("ehl-petsc: scene '{}' is valid", opts.scene.display());
@@ -116,7 +127,7 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {
-        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => study::run(&ctx, &scene, n, opts.ladder),
+        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => study::run(&ctx, &scene, n, opts.ladder, opts.first_size),
         Some(_) => Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into()),
         None => simulate(&ctx, &scene),
     };

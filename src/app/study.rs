@@ -40,11 +40,11 @@ impl std::str::FromStr for Ladder {
 }
 
 impl Ladder {
-    /// The most levels the ladder offers.
-    fn max_levels(self) -> usize {
+    /// The first level's size when `--first-size` is not given (units of a).
+    pub fn default_first(self) -> f64 {
         match self {
-            Ladder::Core => 6,
-            Ladder::Ring => 4,
+            Ladder::Core => 0.5,
+            Ladder::Ring => 0.125,
         }
     }
 
@@ -57,13 +57,29 @@ impl Ladder {
     }
 }
 
-/// Refined size of level k (units of a): the contact zone's (core ladder, 0.5, 0.25, ...)
-/// or the ring's (ring ladder, 0.125, 0.0625, ...).
-pub fn level_size(ladder: Ladder, k: usize) -> f64 {
-    match ladder {
-        Ladder::Core => 0.5 / (1u64 << k) as f64,
-        Ladder::Ring => 0.125 / (1u64 << k) as f64,
+/// Refined size of level k (units of a): the first level's size halved k times (core
+/// ladder: 0.5, 0.25, ... by default; ring ladder: 0.125, 0.0625, ...).
+pub fn level_size(first: f64, k: usize) -> f64 {
+    first / (1u64 << k) as f64
+}
+
+/// Checks a ladder of `levels` levels from size `first`: at least 2 levels, a first size
+/// the mesher can make exactly (16/2^k), and a finest level no finer than the mesher's
+/// smallest size.
+pub fn check_ladder(ladder: Ladder, first: f64, levels: usize) -> Result<(), String> {
+    let min = crate::case::MIN_CONTACT_SIZE;
+    if !(first.is_finite() && first > 0.0 && crate::mesh::spec::dyadic_size(first) == first && first <= 16.0) {
+        return Err(format!("--first-size {first}: the first level's {} size must be 16/2^k a (0.5, 0.25, 0.125, ...), at most 16", ladder.sized()));
     }
+    let finest = level_size(first, levels.max(1) - 1);
+    if levels < 2 || finest < min * (1.0 - 1e-12) {
+        let max = (first / min).log2().round() as usize + 1;
+        return Err(format!(
+            "--convergence-study {levels}: the number of levels must be in [2, {max}] for the {ladder:?} ladder from {first} a (the finest {} size allowed is {min} a)",
+            ladder.sized()
+        ));
+    }
+    Ok(())
 }
 
 /// The scene with the mesh of level size `h`.
@@ -119,21 +135,15 @@ struct Level {
     r: PointResult,
 }
 
-pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder) -> Result<(), String> {
-    let max = ladder.max_levels();
-    if !(2..=max).contains(&levels) {
-        return Err(format!(
-            "--convergence-study {levels}: the number of levels must be in [2, {max}] for the {ladder:?} ladder (its level {max} has a {} size of {} a)",
-            ladder.sized(),
-            level_size(ladder, max - 1)
-        ));
-    }
+pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: Option<f64>) -> Result<(), String> {
+    let first = first.unwrap_or(ladder.default_first());
+    check_ladder(ladder, first, levels)?;
     if scene.is_sweep() {
         return Err("--convergence-study solves one operating point: remove [sweep] from the scene".into());
     }
     let mut rows: Vec<Level> = Vec::new();
     for k in 0..levels {
-        let h = level_size(ladder, k);
+        let h = level_size(first, k);
         let sc = level_scene(scene, ladder, h);
         ctx.log(format!("convergence study: level {} of {levels}, {} size {h} a", k + 1, ladder.sized()));
         let t0 = Instant::now();
@@ -284,8 +294,18 @@ mod tests {
 
     #[test]
     fn ladder_halves_the_contact_zone_size() {
-        assert_eq!([0, 1, 2, 3].map(|k| level_size(Ladder::Core, k)), [0.5, 0.25, 0.125, 0.0625]);
-        assert_eq!([0, 1, 2].map(|k| level_size(Ladder::Ring, k)), [0.125, 0.0625, 0.03125]);
+        assert_eq!([0, 1, 2, 3].map(|k| level_size(Ladder::Core.default_first(), k)), [0.5, 0.25, 0.125, 0.0625]);
+        assert_eq!([0, 1, 2].map(|k| level_size(Ladder::Ring.default_first(), k)), [0.125, 0.0625, 0.03125]);
+        // The ladders' limits: 6 core levels from 0.5 a, 4 ring levels from 0.125 a, 3 from
+        // 0.0625 a (the mesher's finest size is 1/64 a); a first size must be 16/2^k.
+        assert!(check_ladder(Ladder::Core, 0.5, 6).is_ok());
+        assert!(check_ladder(Ladder::Core, 0.5, 7).unwrap_err().contains("[2, 6]"));
+        assert!(check_ladder(Ladder::Ring, 0.125, 4).is_ok());
+        assert!(check_ladder(Ladder::Ring, 0.0625, 3).is_ok());
+        assert!(check_ladder(Ladder::Ring, 0.0625, 4).unwrap_err().contains("[2, 3]"));
+        assert!(check_ladder(Ladder::Ring, 0.0625, 1).is_err());
+        assert!(check_ladder(Ladder::Ring, 0.1, 3).unwrap_err().contains("--first-size 0.1"));
+        assert!(check_ladder(Ladder::Ring, -1.0, 3).is_err());
         assert_eq!("ring".parse::<Ladder>(), Ok(Ladder::Ring));
         // The ring ladder keeps the scene's mesh and sets the ring; the core ladder drops it.
         let mut scene = crate::case::parse_scene(include_str!("../../cases/paper/table2-ue2.toml"), "x").unwrap();

@@ -701,7 +701,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     //    square root, and so on, on failure). table2-ue2 with the ring halved, xi = 1e4: 11
     //    iterations at 1e3, then 7 to 1e4 (135 s); by factors of sqrt(10): 6 + 5 (162 s);
     //    plain Newton at 1e4 from the Hertz start: DIVERGED_MAX_IT after 30.
-    if let (Some(from), true) = (state.take(), staged) {
+    if let Some(from) = state.take_if(|_| staged) {
         let h = Homotopy {
             name: "penalty",
             start: PENALTY_START / xi,
