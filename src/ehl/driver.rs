@@ -244,7 +244,6 @@ pub const CONDENSED_PREFIX: &std::ffi::CStr = c"condensed_";
 
 /// The condensed path: Newton on (P, H0) with the face compliance `comp`, from the Hertz
 /// start or from a previous state `start` (monolithic layout).
-
 fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, comp: &crate::solid::condense::Compliance, half: bool, start: Option<&[f64]>) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
@@ -456,6 +455,10 @@ struct Homotopy {
 /// Sets a scene's problem at continuation parameter t.
 type SceneAt = Box<dyn Fn(&mut Scene, f64)>;
 
+/// One Newton solve of a scene changed by a homotopy at t, from a start, with a label for
+/// the path: the report and, if converged, the state.
+type SolveAt<'a> = dyn Fn(&Scene, &Homotopy, f64, &mut dyn EhlProblem, &[f64], String) -> Result<(SolveReport, Option<Vec<f64>>), String> + 'a;
+
 /// Newton from `x0` (described by `label`) at the scene's operating point. With
 /// `continuation` set, a stiff cavitation penalty (xi > 1e3) is solved at xi = 1e3 first;
 /// if that fails, a continuation in the tilt angle (spin), then in pressure-viscosity, then
@@ -590,7 +593,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     // multiplying t by `h.ratio`, by its square root after each failure, and giving up below
     // a ratio of 1.05. Returns whether t = 1 converged, the last report and the last
     // converged state.
-    let ramp = |solve_h: &dyn Fn(&Scene, &Homotopy, f64, &mut dyn EhlProblem, &[f64], String) -> Result<(SolveReport, Option<Vec<f64>>), String>,
+    let ramp = |solve_h: &SolveAt,
                 sc0: &Scene,
                 h: &Homotopy,
                 mut t: f64,
