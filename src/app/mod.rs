@@ -91,8 +91,9 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
         }
     };
     // A convergence study's ladder is checked with the scene (exit 2, nothing written).
+    let first_size = opts.first_size.unwrap_or(opts.ladder.default_first());
     if let Some(n) = opts.study_levels {
-        if let Err(e) = study::check_ladder(opts.ladder, opts.first_size.unwrap_or(opts.ladder.default_first()), n) {
+        if let Err(e) = study::check_ladder(opts.ladder, first_size, n) {
             if rank == 0 {
                 eprintln!("ehl-petsc: error: {e}");
             }
@@ -127,7 +128,7 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {
-        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => study::run(&ctx, &scene, n, opts.ladder, opts.first_size),
+        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => study::run(&ctx, &scene, n, opts.ladder, first_size),
         Some(_) => Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into()),
         None => simulate(&ctx, &scene),
     };

@@ -135,9 +135,9 @@ struct Level {
     r: PointResult,
 }
 
-pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: Option<f64>) -> Result<(), String> {
-    let first = first.unwrap_or(ladder.default_first());
-    check_ladder(ladder, first, levels)?;
+/// Solves `scene` on `levels` levels of `ladder` from size `first`; the caller has checked
+/// the ladder with [`check_ladder`] (app::run does, before any output is written).
+pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f64) -> Result<(), String> {
     if scene.is_sweep() {
         return Err("--convergence-study solves one operating point: remove [sweep] from the scene".into());
     }
