@@ -80,8 +80,8 @@ fn run(cli: Cli) -> Result<i32, String> {
                     Err(_) => {
                         // The reason is the run's error line.
                         let log = std::fs::read_to_string(base.with_extension("log")).unwrap_or_default();
-                        let reason = log.lines().find(|l| l.starts_with("ehl-petsc: error")).map(|l| l.trim_start_matches("ehl-petsc: error: ").to_string()).unwrap_or_else(|| "no summary.json and no error line".into());
-                        hard::Run { summary: None, wall_s, error: Some(reason) }
+                        let rc = std::fs::read_to_string(base.with_extension("rc")).ok().and_then(|t| t.trim().parse().ok());
+                        hard::Run { summary: None, wall_s, error: Some(hard::failure_reason(&log, rc)) }
                     }
                 }
             };

@@ -60,6 +60,24 @@ fn nan_keys(s: &Value) -> Vec<String> {
         .collect()
 }
 
+/// Exit code of `timeout` when it stopped the run (`ci/hard -T`).
+pub const TIMEOUT_RC: i32 = 124;
+
+/// Why a run left no summary: the run's error line (`ehl-petsc: error: ...`) if its log has
+/// one; else what its exit code `rc` says (124: `ci/hard -T` stopped it; the ranks may be
+/// killed inside a factorisation before they print anything).
+pub fn failure_reason(log: &str, rc: Option<i32>) -> String {
+    if let Some(l) = log.lines().find(|l| l.starts_with("ehl-petsc: error")) {
+        return l.trim_start_matches("ehl-petsc: error: ").to_string();
+    }
+    match rc {
+        Some(TIMEOUT_RC) => "stopped by the time limit (ci/hard -T)".into(),
+        Some(0) => "exit code 0 but no summary.json".into(),
+        Some(c) => format!("no summary.json and no error line (exit code {c})"),
+        None => "no summary.json and no error line".into(),
+    }
+}
+
 /// The first clause of a failure message (the path of continuation steps is in the log).
 fn short_reason(e: &str) -> String {
     let first = e.split("; path:").next().unwrap_or(e).split("; steps:").next().unwrap_or(e).split("; last domain error").next().unwrap_or(e);
@@ -198,5 +216,14 @@ mod tests {
         r.summary.as_mut().unwrap()["pressure"]["pmax_pa"] = serde_json::Value::Null;
         let (_, f) = check_case("nan", &r, &run(3.0e-7, 1.0e-7, 0.0));
         assert!(f.iter().any(|m| m.contains("NaN in pressure.pmax_pa")), "{f:?}");
+    }
+
+    #[test]
+    fn a_run_without_summary_says_why() {
+        let log = "[ 1.0 s] mesh: ...\nehl-petsc: error: Newton did not converge: DIVERGED_MAX_IT\n";
+        assert_eq!(failure_reason(log, Some(1)), "Newton did not converge: DIVERGED_MAX_IT");
+        assert_eq!(failure_reason("[ 1.0 s] mesh\n", Some(TIMEOUT_RC)), "stopped by the time limit (ci/hard -T)");
+        assert!(failure_reason("", Some(137)).contains("exit code 137"));
+        assert_eq!(failure_reason("", None), "no summary.json and no error line");
     }
 }
