@@ -27,7 +27,7 @@ fn converged_lubricated_run_writes_all_outputs() {
         assert!(text.starts_with("x_m,z_m,p_pa,h_m\n"), "{f}");
         assert_eq!(text.lines().count(), 602, "{f}");
     }
-    for f in ["pressure_map.png", "film_map.png", "profile_x0.png", "profile_z0.png"] {
+    for f in ["pressure_map.png", "film_map.png", "film_map_contact.png", "profile_x0.png", "profile_z0.png"] {
         let bytes = std::fs::read(out_dir.join(f)).unwrap();
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{f} is not a PNG");
     }

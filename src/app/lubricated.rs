@@ -329,6 +329,11 @@ fn write_plots(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, prof
         let path = dir.join(name);
         crate::output::write_atomic_with(&path, |t| map_plot(t, title, "x / a", "z / a", &tris, vals, &opts(label, range)))?;
     }
+    // The contact itself: |x|, |z| <= 1.3 a, colours up to 1.5 hc, so the side lobes, the
+    // outlet constriction and the minimum film stand out.
+    let zoom = MapOpts { x_range: Some((-1.3, 1.3)), y_range: Some((-1.3, 1.3)), ..opts("h (um)", Some((0.0, 1.5 * fields.stats().hc * hs * 1e6))) };
+    let path = dir.join("film_map_contact.png");
+    crate::output::write_atomic_with(&path, |t| map_plot(t, "film thickness in the contact (colours saturate at 1.5 hc)", "x / a", "z / a", &tris, &hv, &zoom))?;
     for (name, title, rows, col, xl) in [
         ("profile_z0.png", "centre line z = 0 (rolling direction)", prof_z0, 0usize, "x / a"),
         ("profile_x0.png", "centre line x = 0 (transverse)", prof_x0, 1usize, "z / a"),

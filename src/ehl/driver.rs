@@ -439,15 +439,20 @@ struct NewtonOutcome {
 /// scene itself; smaller t: milder).
 struct Homotopy {
     name: &'static str,
-    /// First t tried from the start, halved down to `lowest` until Newton converges.
-    start: f64,
-    lowest: f64,
     /// First factor on t when ramping to t = 1.
     ratio: f64,
     apply: SceneAt,
     show: Box<dyn Fn(f64) -> String>,
     /// The parameter changes the entrainment velocity field (tilt angle).
     kinematic: bool,
+}
+
+/// A homotopy that first searches a milder problem Newton solves from the Hertz start.
+struct Search {
+    h: Homotopy,
+    /// First t tried from the start, halved down to `lowest` until Newton converges.
+    start: f64,
+    lowest: f64,
     /// The scene has this parameter to vary (alpha > 0; spin kinematics below 90 deg).
     applies: bool,
 }
@@ -637,44 +642,59 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
         let tilt = scene.operating.tilt_angle;
         // A small tilt angle (strong spin) is milder at a larger one; only with spin kinematics.
         let spin = scene.effects.kinematics == crate::case::KinematicsModel::Spin && tilt < 90.0;
-        let homotopies: Vec<Homotopy> = vec![
-            Homotopy {
-                name: "tilt",
+        let searches: Vec<Search> = vec![
+            Search {
+                h: Homotopy {
+                    name: "tilt",
+                    ratio: 2.0,
+                    apply: Box::new(move |sc: &mut Scene, t| sc.operating.tilt_angle = (tilt / t).min(90.0)),
+                    show: Box::new(move |t| format!("lambda = {:.4} deg", (tilt / t).min(90.0))),
+                    kinematic: true,
+                },
                 start: 0.5,
                 lowest: 1.0 / 64.0,
-                ratio: 2.0,
-                apply: Box::new(move |sc: &mut Scene, t| sc.operating.tilt_angle = (tilt / t).min(90.0)),
-                show: Box::new(move |t| format!("lambda = {:.4} deg", (tilt / t).min(90.0))),
-                kinematic: true,
                 applies: spin,
             },
-            Homotopy {
-                name: "pressure-viscosity",
+            Search {
+                h: Homotopy {
+                    name: "pressure-viscosity",
+                    ratio: 2.0,
+                    apply: Box::new(move |sc: &mut Scene, t| {
+                        if let Some(l) = sc.lubricant.as_mut() {
+                            l.pressure_viscosity = l.pressure_viscosity.map(|_| alpha * t);
+                            l.roelands_exponent = z.map(|z| z * t);
+                        }
+                    }),
+                    show: Box::new(move |t| format!("alpha = {:.4} GPa^-1", alpha * t * 1e9)),
+                    kinematic: false,
+                },
                 start: 0.5,
                 lowest: 0.125,
-                ratio: 2.0,
-                apply: Box::new(move |sc: &mut Scene, t| {
-                    if let Some(l) = sc.lubricant.as_mut() {
-                        l.pressure_viscosity = l.pressure_viscosity.map(|_| alpha * t);
-                        l.roelands_exponent = z.map(|z| z * t);
-                    }
-                }),
-                show: Box::new(move |t| format!("alpha = {:.4} GPa^-1", alpha * t * 1e9)),
-                kinematic: false,
                 applies: alpha > 0.0,
             },
-            Homotopy { name: "load", start: 1.0 / 8.0, lowest: 1.0 / 64.0, ratio: 2.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.load = target * t), show: Box::new(move |t| format!("L = {:.4} N", target * t)), kinematic: false, applies: true },
-            Homotopy { name: "speed", start: 0.25, lowest: 1.0 / 64.0, ratio: 2.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.entrainment_speed = Some(ue / t)), show: Box::new(move |t| format!("Ue = {:.4} m/s", ue / t)), kinematic: false, applies: true },
+            Search {
+                h: Homotopy { name: "load", ratio: 2.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.load = target * t), show: Box::new(move |t| format!("L = {:.4} N", target * t)), kinematic: false },
+                start: 1.0 / 8.0,
+                lowest: 1.0 / 64.0,
+                applies: true,
+            },
+            Search {
+                h: Homotopy { name: "speed", ratio: 2.0, apply: Box::new(move |sc: &mut Scene, t| sc.operating.entrainment_speed = Some(ue / t)), show: Box::new(move |t| format!("Ue = {:.4} m/s", ue / t)), kinematic: false },
+                start: 0.25,
+                lowest: 1.0 / 64.0,
+                applies: true,
+            },
         ];
-        for h in &homotopies {
+        for Search { h, start, lowest, applies } in &searches {
+            let (start, lowest) = (*start, *lowest);
             // A kinematic parameter also needs a problem whose velocity field can change.
-            if !h.applies || (h.kinematic && !system.set_velocity(velocity_field(scene))) {
+            if !applies || (h.kinematic && !system.set_velocity(velocity_field(scene))) {
                 continue;
             }
             // Find a milder problem Newton solves from the start.
-            let mut t = h.start;
+            let mut t = start;
             let mut found: Option<Vec<f64>> = None;
-            while t >= h.lowest {
+            while t >= lowest {
                 let (_, xs) = solve_h(&base, h, t, system, x0, format!("{label} at "))?;
                 if xs.is_some() {
                     found = xs;
@@ -683,7 +703,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
                 t /= 2.0;
             }
             let Some(from) = found else {
-                note(format!("{} continuation: no milder problem converged down to {}", h.name, (h.show)(h.lowest)));
+                note(format!("{} continuation: no milder problem converged down to {}", h.name, (h.show)(lowest)));
                 continue;
             };
             let (done, r, xs) = ramp(&solve_h, &base, h, t, from, system)?;
@@ -707,15 +727,12 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     if let Some(from) = state.take_if(|_| staged) {
         let h = Homotopy {
             name: "penalty",
-            start: PENALTY_START / xi,
-            lowest: PENALTY_START / xi,
             ratio: xi / PENALTY_START,
             apply: Box::new(move |sc: &mut Scene, t| sc.reynolds.penalty = xi * t),
             show: Box::new(move |t| format!("xi = {:.4e}", xi * t)),
             kinematic: false,
-            applies: true,
         };
-        let (done, r, xs) = ramp(&solve_h, scene, &h, h.start, from, system)?;
+        let (done, r, xs) = ramp(&solve_h, scene, &h, PENALTY_START / xi, from, system)?;
         if let Some(r) = r {
             last = r;
         }
