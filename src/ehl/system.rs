@@ -274,6 +274,11 @@ pub trait EhlProblem: Problem {
     fn set_velocity(&mut self, _velocity: Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync>) -> bool {
         false
     }
+    /// Where (X, Z in units of a) the last Newton solve stopped because the film closed
+    /// (the step limiter drove a nodal film to nothing); cleared by the call.
+    fn take_collapse(&mut self) -> Option<[f64; 2]> {
+        None
+    }
 }
 
 impl EhlProblem for EhlSystem<'_> {
