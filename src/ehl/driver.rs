@@ -477,7 +477,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     let x = Vector::new(comm, local).map_err(pe)?;
     let snes = Snes::new(comm, "").map_err(pe)?;
     let scaling = std::env::var_os("EHL_NO_ROW_SCALING").is_none();
-    // Where the film last closed, if a solve stopped for that.
+    // Where the film closed, if the last solve stopped for that.
     let collapse: std::cell::Cell<Option<Collapse>> = std::cell::Cell::new(None);
     let solve_scene = |sc: &Scene, system: &mut dyn EhlProblem, start: &[f64]| -> Result<SolveReport, String> {
         system.set_operating(lambda_bar(sc), lubricant(sc), penalty(sc));
@@ -486,6 +486,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
             system.scale_rows(start).map_err(pe)?;
         }
         system.take_collapse();
+        collapse.set(None);
         let mut r = snes.solve(system, &x, j).map_err(pe)?;
         if let (false, Some(c)) = (r.converged, system.take_collapse()) {
             r.reason = format!("{}: film closed at ({:.3}, {:.3})a", r.reason, c[0], c[1]);
