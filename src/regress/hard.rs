@@ -81,8 +81,10 @@ pub fn failure_reason(log: &str, rc: Option<i32>) -> String {
 /// The first clause of a failure message (the path of continuation steps is in the log).
 fn short_reason(e: &str) -> String {
     let first = e.split("; path:").next().unwrap_or(e).split("; steps:").next().unwrap_or(e).split("; last domain error").next().unwrap_or(e);
-    if first.chars().count() > 120 {
-        format!("{}...", first.chars().take(120).collect::<String>())
+    // Room for the reason behind a failure, e.g. the film closing next to a spin pole.
+    const ROOM: usize = 260;
+    if first.chars().count() > ROOM {
+        format!("{}...", first.chars().take(ROOM).collect::<String>())
     } else {
         first.to_string()
     }
