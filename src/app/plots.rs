@@ -81,10 +81,17 @@ pub fn velocity_plots(dir: &Path, k: &Kinematics, a: f64, _rect: &Rect) -> Resul
     let ball = grid(&|x, z| [k.u_b(x, z), k.w_b(x, z)]);
     let disc = grid(&|x, z| [k.u_d(x, z), k.w_d(x, z)]);
     let slide = grid(&|x, z| [k.du(x, z), k.dw(x, z)]);
+    let mean = grid(&|x, z| [k.um(x, z), k.wm(x, z)]);
+    // The mean velocity carries the lubricant; with spin it turns about the spin pole.
+    let mean_title = match k.spin_centre() {
+        Some((zc, _)) => format!("mean velocity (Um, Wm): turns about the spin pole (0, {:.3} a)", zc / a),
+        None => "mean velocity (Um, Wm)".to_string(),
+    };
     for (name, title, arrows) in [
         ("velocity_ball.png", "ball surface velocity (U_B, W_B)", &ball),
         ("velocity_disc.png", "disc surface velocity (U_D, W_D)", &disc),
         ("velocity_sliding.png", "sliding velocity (U_B - U_D, W_B - W_D)", &slide),
+        ("velocity_mean.png", mean_title.as_str(), &mean),
     ] {
         write_atomic_with(&dir.join(name), |t| quiver_plot(t, title, "x / a", "z / a", arrows, &opts))?;
     }
