@@ -416,18 +416,15 @@ impl Problem for EhlSystem<'_> {
             return Ok(1.0);
         }
         let dh0 = y[self.layout.h0 as usize];
-        let mut s: f64 = 1.0;
-        let mut at = [0.0; 4];
-        for &n in &self.mesh.contact_nodes {
-            let c = self.mesh.nodes[n as usize];
-            let (h, duy) = (self.layout.film(self.mesh, x, n), self.layout.uy(y, n));
-            // x_new = x - y: H_new = H - (dh0 - duy)
-            let dh = dh0 - duy;
-            if dh > 0.0 && h > 0.0 && (1.0 - FILM_KEEP) * h / dh < s {
-                s = (1.0 - FILM_KEEP) * h / dh;
-                at = [c[0], c[2], h, dh];
-            }
-        }
+        let nodes = &self.mesh.contact_nodes;
+        let h: Vec<f64> = nodes.iter().map(|&n| self.layout.film(self.mesh, x, n)).collect();
+        // x_new = x - y: H_new = H - (dh0 - duy)
+        let dh: Vec<f64> = nodes.iter().map(|&n| dh0 - self.layout.uy(y, n)).collect();
+        let (s, binding) = super::condensed::film_step_limit(&h, &dh, FILM_KEEP);
+        let at = binding.map(|k| {
+            let c = self.mesh.nodes[nodes[k] as usize];
+            [c[0], c[2], h[k], dh[k]]
+        });
         self.step_limits.push(s);
         if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
             eprintln!("EHL_DEBUG step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e} binding at X,Z,H,dH = {at:?}", x[self.layout.h0 as usize]);
