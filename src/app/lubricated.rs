@@ -119,9 +119,9 @@ pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
 pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let hertz = scene.hertz();
     ctx.log(format!("Hertz: a = {:.5e} m, p_H = {:.5e} Pa; lambda_bar = {:.4e}", hertz.a, hertz.ph, driver::lambda_bar(scene)));
-    if let Some((zc, _)) = scene.kinematics().and_then(|k| k.spin_centre()) {
-        let inside = if zc.abs() < hertz.a { ": inside the Hertz circle, so the lubricant circulates on closed streamlines in the contact (the hardest spin regime)" } else { "" };
-        ctx.log(format!("spin: the mean surface velocity turns about (0, {:.3}a){inside}", zc / hertz.a));
+    if let Some(zc) = scene.spin_pole_over_a() {
+        let inside = if zc.abs() < 1.0 { ": inside the Hertz circle, so the lubricant circulates on closed streamlines in the contact (the hardest spin regime)" } else { "" };
+        ctx.log(format!("spin: the mean surface velocity turns about (0, {zc:.3}a){inside}"));
     }
     let setup = Setup::new(ctx, scene)?;
     let report = effects_report(scene, setup.half);
@@ -247,7 +247,7 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
         "kinematics": {
             "model": scene.effects.kinematics.as_str(),
             "omega_B_rad_s": kin.omega_b, "omega_D_rad_s": kin.omega_d, "U_BO_m_s": kin.u_bo, "U_DO_m_s": kin.u_do,
-            "spin_centre_z_m": kin.spin_centre().map(|c| c.0),
+            "spin_centre_z_m": kin.spin_centre(),
         },
         "mesh": {
             "elements": mesh.tets.len(), "nodes": mesh.nodes.len(), "dofs_total": layout.total(),

@@ -84,7 +84,7 @@ pub fn velocity_plots(dir: &Path, k: &Kinematics, a: f64, _rect: &Rect) -> Resul
     let mean = grid(&|x, z| [k.um(x, z), k.wm(x, z)]);
     // The mean velocity carries the lubricant; with spin it turns about the spin pole.
     let mean_title = match k.spin_centre() {
-        Some((zc, _)) => format!("mean velocity (Um, Wm): turns about the spin pole (0, {:.3} a)", zc / a),
+        Some(zc) => format!("mean velocity (Um, Wm): turns about the spin pole (0, {:.3} a)", zc / a),
         None => "mean velocity (Um, Wm)".to_string(),
     };
     for (name, title, arrows) in [

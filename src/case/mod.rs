@@ -430,6 +430,12 @@ impl Scene {
         })
     }
 
+    /// z of the spin pole (where the mean surface velocity vanishes) in units of the Hertz
+    /// radius a; None without spin kinematics or an entrainment speed.
+    pub fn spin_pole_over_a(&self) -> Option<f64> {
+        Some(self.kinematics()?.spin_centre()? / self.hertz().a)
+    }
+
     /// Surface kinematics selected by `effects.kinematics`, or None without an entrainment
     /// speed (dry scenes).
     pub fn kinematics(&self) -> Option<Kinematics> {

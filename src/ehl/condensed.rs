@@ -132,7 +132,8 @@ fn penalty_slope(p: f64) -> f64 {
 /// The condensed EHL problem on one rank (all data replicated; rows distributed).
 pub struct CondensedSystem<'a> {
     pub comp: &'a Compliance,
-    /// Mesh, for developer diagnostics only.
+    /// Mesh: node coordinates for messages (domain errors, where the film closed) and
+    /// developer diagnostics.
     pub debug_mesh: Option<&'a Mesh>,
     pub layout: CondensedLayout,
     pub rank: usize,
@@ -163,6 +164,11 @@ pub struct CondensedSystem<'a> {
 }
 
 impl<'a> CondensedSystem<'a> {
+    /// (X, Z) in units of a of face row k (a compliance row), if the mesh is known.
+    fn face_xz(&self, k: usize) -> Option<[f64; 2]> {
+        self.debug_mesh.map(|m| m.nodes[self.comp.rows[k] as usize]).map(|c| [c[0], c[2]])
+    }
+
     pub fn new(mesh: &Mesh, comp: &'a Compliance, nranks: usize, rank: usize, params: EhlParams, lubricant: Lubricant) -> Self {
         let layout = CondensedLayout::new(mesh, comp, nranks);
         let (lo, hi) = (layout.ranges[rank], layout.ranges[rank + 1].min(layout.n_p));
@@ -477,7 +483,7 @@ impl Problem for CondensedSystem<'_> {
         // Every rank holds the same iterate and the same compliance: the domain check
         // agrees everywhere without communication.
         if let Some(k) = h.iter().position(|v| !(*v > 0.0) || !v.is_finite()) {
-            let at = self.debug_mesh.map(|m| m.nodes[self.comp.rows[k] as usize]).map(|c| format!(" (X, Z) = ({:.3}, {:.3})", c[0], c[2])).unwrap_or_default();
+            let at = self.face_xz(k).map(|c| format!(" (X, Z) = ({:.3}, {:.3})", c[0], c[1])).unwrap_or_default();
             return Ok(Eval::Domain(format!("film thickness H = {:.3e} at face node {}{at}", h[k], self.comp.rows[k])));
         }
         let (lo, hi) = self.owned();
@@ -550,13 +556,12 @@ impl Problem for CondensedSystem<'_> {
         // to nothing. Stop this solve (a zero step fails the line search at once) instead of
         // crawling on (21-30 iterations of steps of 1e-3 .. 1e-14 on the strong-spin scene).
         if let Some(k) = binding.filter(|&k| h[k] < FILM_COLLAPSE) {
-            let c = self.debug_mesh.map(|m| m.nodes[self.comp.rows[k] as usize]).unwrap_or([f64::NAN; 3]);
-            self.collapse = Some([c[0], c[2]]);
+            self.collapse = Some(self.face_xz(k).unwrap_or([f64::NAN; 2]));
             return Ok(0.0);
         }
         if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
             let k = (0..h.len()).min_by(|&a, &b| h[a].partial_cmp(&h[b]).unwrap()).unwrap();
-            let at = self.debug_mesh.map(|m| m.nodes[self.comp.rows[k] as usize]).map(|c| format!(" (X, Z) = ({:.3}, {:.3})", c[0], c[2])).unwrap_or_default();
+            let at = self.face_xz(k).map(|c| format!(" (X, Z) = ({:.3}, {:.3})", c[0], c[1])).unwrap_or_default();
             eprintln!("EHL_DEBUG limiter {s:.3e}; H0 = {:.4e} dH0 = {dh0:.3e}; min H = {:.3e} at node {}{at}", x[self.layout.h0()], h[k], self.comp.rows[k]);
             self.debug_dump(x, &h);
         }

@@ -490,8 +490,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
         let mut r = snes.solve(system, &x, j).map_err(pe)?;
         if let (false, Some(c)) = (r.converged, system.take_collapse()) {
             r.reason = format!("{}: film closed at ({:.3}, {:.3})a", r.reason, c[0], c[1]);
-            let pole = sc.kinematics().and_then(|k| k.spin_centre()).map(|(z, _)| z / sc.hertz().a);
-            collapse.set(Some(Collapse { at: c, pole }));
+            collapse.set(Some(Collapse { at: c, pole: sc.spin_pole_over_a() }));
         }
         Ok(r)
     };

@@ -212,18 +212,14 @@ impl Kinematics {
     pub fn dw(&self, x: f64, z: f64) -> f64 {
         self.at(x, z).dw()
     }
-    /// The spin centre: the point (0, z_c) about which the mean velocity (Um, Wm) turns
-    /// (Um = Wm = 0 there), z_c = -2 Ue / (omega_B cos lambda + omega_D) (m), with the mean
-    /// angular speed (omega_B cos lambda + omega_D)/2 (rad/s). The lubricant's streamlines
-    /// are circles about it: where the circle through a point stays inside the pressurised
-    /// zone, the Couette flow never leaves the contact (closed streamlines). None without
-    /// spin (uniform entrainment).
-    pub fn spin_centre(&self) -> Option<(f64, f64)> {
-        if !self.spin {
-            return None;
-        }
-        let twice_omega = self.omega_b * self.lambda.cos() + self.omega_d;
-        Some((-2.0 * self.ue / twice_omega, 0.5 * twice_omega))
+    /// z_c (m) of the spin centre (0, z_c), about which the mean velocity (Um, Wm) turns
+    /// at (omega_B cos lambda + omega_D)/2 (Um = Wm = 0 there):
+    /// z_c = -2 Ue / (omega_B cos lambda + omega_D). The lubricant's streamlines are circles
+    /// about it: where the circle through a point stays inside the pressurised zone, the
+    /// Couette flow never leaves the contact (closed streamlines). None without spin
+    /// (uniform entrainment).
+    pub fn spin_centre(&self) -> Option<f64> {
+        self.spin.then(|| -2.0 * self.ue / (self.omega_b * self.lambda.cos() + self.omega_d))
     }
 }
 
@@ -238,7 +234,7 @@ mod tests {
         // (outside the Hertz circle, a = 0.92e-3 m), -6.7550108e-4 m at 0.25 deg (inside).
         for (deg, zc) in [(0.5, -1.33999572e-3), (0.25, -6.7550108e-4)] {
             let k = Kinematics::new(3.0, 0.05, f64::to_radians(deg), 0.08, 0.04).unwrap();
-            let (z, _) = k.spin_centre().unwrap();
+            let z = k.spin_centre().unwrap();
             assert!((z / zc - 1.0).abs() < 1e-7, "{deg} deg: {z} vs {zc}");
             assert!(k.um(0.0, z).abs() < 1e-9 && k.wm(0.0, z).abs() < 1e-12);
         }
