@@ -12,6 +12,8 @@
 //! - [`regress`]: summary.json comparison (regression runner) and the hard suite's checks.
 // `!(x > 0.0)` is written on purpose throughout: it rejects NaN as well as x <= 0.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+// `pcall!` wraps its argument, a PETSc FFI call, in `unsafe` by design (petsc/error.rs).
+#![allow(clippy::macro_metavars_in_unsafe)]
 pub mod app;
 pub mod case;
 pub mod ehl;

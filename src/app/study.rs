@@ -120,6 +120,38 @@ pub fn richardson(q: &[f64]) -> Option<(f64, f64)> {
     Some((q[n - 1] + d2 / (2f64.powf(p) - 1.0), p))
 }
 
+/// How the last three values of a sequence on meshes halving h behave, after Stern,
+/// Wilson, Coleman and Paterson (J. Fluids Eng. 123, 2001, "Comprehensive approach to
+/// verification and validation of CFD simulations, part 1"), with the convergence ratio
+/// R = (q3 - q2)/(q2 - q1) (q3 the finest):
+/// 0 <= R < 1 monotone convergence (Richardson applies), -1 < R < 0 oscillatory convergence
+/// (uncertainty half the range of the three values), |R| >= 1 divergence (no estimate).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Convergence {
+    Monotone { ratio: f64 },
+    Oscillatory { ratio: f64, half_range: f64 },
+    Diverging { ratio: f64 },
+}
+
+/// [`Convergence`] of the last three values of `q` (None for fewer than three values or two
+/// equal coarser values).
+pub fn convergence(q: &[f64]) -> Option<Convergence> {
+    let n = q.len();
+    if n < 3 || q[n - 2] == q[n - 3] {
+        return None;
+    }
+    let ratio = (q[n - 1] - q[n - 2]) / (q[n - 2] - q[n - 3]);
+    let last = &q[n - 3..];
+    let (lo, hi) = last.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    Some(if ratio.abs() >= 1.0 {
+        Convergence::Diverging { ratio }
+    } else if ratio < 0.0 {
+        Convergence::Oscillatory { ratio, half_range: 0.5 * (hi - lo) }
+    } else {
+        Convergence::Monotone { ratio }
+    })
+}
+
 struct Level {
     /// Why the level failed (None: converged).
     failed: Option<String>,
@@ -236,7 +268,18 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level]) -> Result<(), Stri
         match refs[qi].1 {
             Some(p) => md.push_str(&format!("- {name}: {:.5e} (Richardson, observed order {p:.2})\n", refs[qi].0)),
             None if rows.len() < 3 => md.push_str(&format!("- {name}: {:.5e} = the finest level (fewer than three converged levels: no extrapolation)\n", refs[qi].0)),
-            None => md.push_str(&format!("- {name}: {:.5e} = the finest level (the last differences do not shrink: not in the asymptotic range, no extrapolation)\n", refs[qi].0)),
+            None => {
+                let q = &quantities[qi].1;
+                let why = match convergence(q) {
+                    Some(Convergence::Oscillatory { ratio, half_range }) => format!(
+                        "oscillatory convergence, R = {ratio:.2}: no extrapolation; uncertainty +-{:.2} % (half the range of the last three levels, Stern et al. 2001)",
+                        100.0 * half_range / refs[qi].0.abs()
+                    ),
+                    Some(Convergence::Diverging { ratio }) => format!("the last differences grow, R = {ratio:.2}: not in the asymptotic range, no extrapolation"),
+                    _ => "the last differences do not shrink: not in the asymptotic range, no extrapolation".into(),
+                };
+                md.push_str(&format!("- {name}: {:.5e} = the finest level ({why})\n", refs[qi].0))
+            }
         }
     }
     // Against the finest level itself the error is zero by construction: with no
@@ -290,6 +333,25 @@ mod tests {
         // Oscillating or growing differences: no estimate.
         assert!(richardson(&[1.0, 1.1, 1.05]).is_none());
         assert!(richardson(&[1.0, 1.1, 1.3]).is_none());
+    }
+
+    #[test]
+    fn convergence_is_classified_by_the_ratio_of_the_last_differences() {
+        // Stern et al. (2001): R = (S1 - S2)/(S2 - S3), 1 the finest.
+        let c = |q: &[f64]| convergence(q).unwrap();
+        // q = 1 + 3 h^2: R = 1/4, monotone.
+        assert!(matches!(c(&[1.75, 1.1875, 1.046875]), Convergence::Monotone { ratio } if (ratio - 0.25).abs() < 1e-12));
+        // 1.0, 1.1, 1.05: R = -0.5, oscillatory; half range (1.1 - 1.0)/2.
+        match c(&[1.0, 1.1, 1.05]) {
+            Convergence::Oscillatory { ratio, half_range } => assert!((ratio + 0.5).abs() < 1e-12 && (half_range - 0.05).abs() < 1e-12),
+            other => panic!("{other:?}"),
+        }
+        // Growing differences, either sign: diverging.
+        assert!(matches!(c(&[1.0, 1.1, 1.3]), Convergence::Diverging { .. }));
+        assert!(matches!(c(&[1.0, 1.1, 0.9]), Convergence::Diverging { .. }));
+        // table2-ue2's hm on the narrow ring ladder (um): -0.12 %, then +0.96 %.
+        assert!(matches!(c(&[0.13652, 0.13636, 0.13767]), Convergence::Diverging { ratio } if ratio < -1.0));
+        assert!(convergence(&[1.0, 1.0, 2.0]).is_none() && convergence(&[1.0, 2.0]).is_none());
     }
 
     #[test]

@@ -11,7 +11,6 @@
 //! the condensed (P, H0) one; `EHL_PTC=1` (with `EHL_PTC_DT0`) tries pseudo-transient
 //! continuation before the load continuation; `EHL_SKIP_PLAIN=1` skips the plain Newton
 //! attempt. `EHL_P1ISO=1` (condensed path) uses linear pressure on the P2 sub-triangles;
-//! `EHL_ID_CROSSWIND=1` makes `reynolds.artificial_diffusion` act crosswind only;
 //! `EHL_SUPG_DELTA` scales the SUPG parameter tau (default 1).
 //! With `EHL_DEBUG=1` the condensed path prints its worst residual rows and appends
 //! the iterates' centre lines to /tmp/ehl_debug_lines.csv.
@@ -122,6 +121,7 @@ fn stabilisation(scene: &Scene, penalty: f64) -> crate::reynolds::element::Stabi
         supg: choice != S::Off,
         delta: std::env::var("EHL_SUPG_DELTA").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0),
         id: scene.reynolds.artificial_diffusion,
+        cd: scene.reynolds.crosswind_diffusion,
         penalty,
         // An incompressible lubricant has no film Peclet number (d rho/dP = 0: the
         // pressure is not advected, the element falls back to |v|); with that larger tau

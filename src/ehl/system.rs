@@ -117,6 +117,9 @@ pub struct EhlSystem<'a> {
     pub jacobian_evals: usize,
     /// Step-limiter factors applied at each Newton step (1 = full Newton step).
     pub step_limits: Vec<f64>,
+    /// Where (X, Z) the film closed in the last solve, if it did (see
+    /// [`super::condensed::FILM_COLLAPSE`]).
+    pub collapse: Option<[f64; 2]>,
     /// Constant scale of each Reynolds row (indexed by global row), 1 by default; see
     /// [`EhlSystem::scale_rows`].
     row_scale: std::collections::HashMap<i32, f64>,
@@ -194,6 +197,7 @@ impl<'a> EhlSystem<'a> {
             residual_evals: 0,
             jacobian_evals: 0,
             step_limits: Vec::new(),
+            collapse: None,
             row_scale: std::collections::HashMap::new(),
         })
     }
@@ -282,6 +286,10 @@ pub trait EhlProblem: Problem {
 }
 
 impl EhlProblem for EhlSystem<'_> {
+    fn take_collapse(&mut self) -> Option<[f64; 2]> {
+        self.collapse.take()
+    }
+
     fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64) {
         self.params.set_operating(lambda_bar, penalty);
         self.lubricant = lubricant;
@@ -426,6 +434,13 @@ impl Problem for EhlSystem<'_> {
             [c[0], c[2], h[k], dh[k]]
         });
         self.step_limits.push(s);
+        // As in the condensed system: Newton keeps pushing one nodal film through zero, so
+        // stop this solve (a zero step fails the line search at once).
+        if let Some(k) = binding.filter(|&k| h[k] < super::condensed::FILM_COLLAPSE) {
+            let c = self.mesh.nodes[nodes[k] as usize];
+            self.collapse = Some([c[0], c[2]]);
+            return Ok(0.0);
+        }
         if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
             eprintln!("EHL_DEBUG step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e} binding at X,Z,H,dH = {at:?}", x[self.layout.h0 as usize]);
         }

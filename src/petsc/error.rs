@@ -87,7 +87,9 @@ pub fn rust_error(message: impl Into<String>) -> PetscError {
     PetscError { code: 0, message: message.into() }
 }
 
-/// Calls a PETSc function and converts its return code.
+/// Calls a PETSc function and converts its return code. The unsafe block is the point of
+/// the macro: every argument is an FFI call into PETSc, whose safety its caller argues.
+/// (Hence the crate-level allow of clippy's `macro_metavars_in_unsafe` in `lib.rs`.)
 #[macro_export]
 macro_rules! pcall {
     ($e:expr) => {

@@ -62,6 +62,12 @@ pub struct Stabilisation {
     /// the diffusion coefficient of the Galerkin term, with beta = (d rho_bar/dP) H v the
     /// convection velocity of P in the Couette term. Inconsistent by O(h): 0 switches it off.
     pub id: f64,
+    /// Crosswind diffusion: eps_cd = cd * h_e * |beta| acts across the streamlines only,
+    /// eps_cd [grad P . grad N_i - (t . grad P)(t . grad N_i)], t = v/|v|. It damps the
+    /// crosswind stripes (P2 film modes that the Couette term cannot see, since it only
+    /// differentiates along v) and leaves the streamline balance alone. Inconsistent by
+    /// O(h) like `id`; 0 switches it off.
+    pub cd: f64,
     /// Cavitation penalty factor xi of the equation (0: none). The caller adds the lumped
     /// penalty xi area_i pen(P_i) to row i; the SUPG strong residual needs the same term as
     /// a field, xi sum_j pen(P_j) N_j, or SUPG is inconsistent where the film cavitates
@@ -93,6 +99,7 @@ impl Default for Stabilisation {
             supg: true,
             delta: 1.0,
             id: 0.0,
+            cd: 0.0,
             penalty: 0.0,
             residual: StrongResidual::Full,
             film_peclet: false,
@@ -263,7 +270,6 @@ pub fn reynolds_element_with_source(
         }
     });
 
-    let crosswind = crosswind_diffusion();
     let mut res = [D12::constant(0.0); 6];
     for q in DUNAVANT6.iter() {
         let l = &q.l;
@@ -302,25 +308,27 @@ pub fn reynolds_element_with_source(
         let v_dn: [f64; 6] = std::array::from_fn(|i| v[0] * dn[i][0] + v[1] * dn[i][1]);
         let vn = (v[0] * v[0] + v[1] * v[1]).sqrt();
         // d rho_bar/dP as a dual (built from rho''): needed by the artificial diffusion and SUPG.
-        let drho_d = if stab.id > 0.0 || stab.supg { pq.chain(drho, (fluid.d2rho)(pq.v)) } else { D12::constant(0.0) };
-        // Isotropic artificial diffusion eps_id = id h_e |rho' H v| (exact derivative through
-        // the duals).
-        let eps_a = if stab.id > 0.0 {
+        let diffusion = stab.id > 0.0 || stab.cd > 0.0;
+        let drho_d = if diffusion || stab.supg { pq.chain(drho, (fluid.d2rho)(pq.v)) } else { D12::constant(0.0) };
+        // Artificial diffusion coefficients factor * h_e |rho' H v| (isotropic, crosswind),
+        // with their exact derivatives through the duals.
+        let beta_he = if diffusion {
             let beta = drho_d * hq * vn;
-            let beta_abs = if beta.v < 0.0 { -beta } else { beta };
-            beta_abs * (stab.id * streamline_length(&tri, v))
+            (if beta.v < 0.0 { -beta } else { beta }) * streamline_length(&tri, v)
         } else {
             D12::constant(0.0)
         };
-        let eps_g = if crosswind { eps } else { eps + eps_a };
+        let eps_g = eps + beta_he * stab.id;
+        let eps_c = beta_he * stab.cd;
+        let crosswind = stab.cd > 0.0 && vn > 0.0;
+        let (tx, tz) = if vn > 0.0 { (v[0] / vn, v[1] / vn) } else { (0.0, 0.0) };
         for i in 0..6 {
             let flux = gp[0] * dn[i][0] + gp[1] * dn[i][1];
             res[i] += (eps_g * flux - rho_h * v_dn[i] - f * n[i]) * wq;
-            if crosswind && stab.id > 0.0 && vn > 0.0 {
-                // crosswind only: grad P . grad N - (t . grad P)(t . grad N), t = v/|v|
-                let (tx, tz) = (v[0] / vn, v[1] / vn);
+            if crosswind {
+                // crosswind only: grad P . grad N - (t . grad P)(t . grad N)
                 let cw = flux - (gp[0] * tx + gp[1] * tz) * (dn[i][0] * tx + dn[i][1] * tz);
-                res[i] += eps_a * cw * wq;
+                res[i] += eps_c * cw * wq;
             }
         }
 
@@ -355,11 +363,4 @@ pub fn reynolds_element_with_source(
         out.dr_dh[i].copy_from_slice(&res[i].d[6..]);
     }
     out
-}
-
-/// Developer experiment (`EHL_ID_CROSSWIND=1`): the artificial diffusion acts crosswind only
-/// (grad P . grad N_i minus its streamline part).
-fn crosswind_diffusion() -> bool {
-    static FLAG: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    *FLAG.get_or_init(|| std::env::var_os("EHL_ID_CROSSWIND").is_some())
 }

@@ -100,7 +100,10 @@ mod tests {
     use super::*;
     use crate::reynolds::element::StrongResidual;
 
-    fn laws() -> (impl Fn(f64) -> (f64, f64), impl Fn(f64) -> (f64, f64)) {
+    /// A lubricant law: value and derivative.
+    type Law = fn(f64) -> (f64, f64);
+
+    fn laws() -> (Law, Law) {
         (|p: f64| ((2.0 * p).exp(), 2.0 * (2.0 * p).exp()), |p: f64| ((1.0 + 2.0 * p) / (1.0 + p), 1.0 / ((1.0 + p) * (1.0 + p))))
     }
 

@@ -33,11 +33,11 @@ impl DofMap {
             if mesh.clamped[n] {
                 continue;
             }
-            for c in 0..3 {
+            for (c, dof) in node_dof[n].iter_mut().enumerate() {
                 if c == 2 && mesh.symmetry[n] {
                     continue;
                 }
-                node_dof[n][c] = next;
+                *dof = next;
                 next += 1;
             }
         }
