@@ -68,3 +68,26 @@ fn help_documents_petsc_options() {
     let t = text(&out);
     assert!(t.contains("PETSC_OPTIONS") && t.contains("-ksp_view") && t.contains("--output"), "{t}");
 }
+
+/// Every scene the repository ships (cases/**/*.toml) passes validation: a scene key renamed
+/// or a range tightened must not leave a shipped scene behind.
+#[test]
+fn every_shipped_scene_is_valid() {
+    let mut scenes = Vec::new();
+    let mut dirs = vec![repo().join("cases")];
+    while let Some(d) = dirs.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                dirs.push(p);
+            } else if p.extension().is_some_and(|x| x == "toml") {
+                scenes.push(p);
+            }
+        }
+    }
+    assert!(scenes.len() >= 20, "found only {} scenes", scenes.len());
+    for s in &scenes {
+        let out = run_plain(&["--check", s.to_str().unwrap()]);
+        assert!(out.status.success(), "{} does not validate:\n{}", s.display(), text(&out));
+    }
+}
