@@ -56,8 +56,10 @@ impl CondensedLayout {
 struct Element {
     /// Face index of the 6 nodes.
     face: [usize; 6],
-    /// Pressure unknown of the 6 nodes (-1 on the Dirichlet edges).
-    p: [i32; 6],
+    /// The pressure unknowns each of the 6 nodes takes its pressure from, with weights
+    /// (unknown -1 or weight 0: none; the Dirichlet edges have no unknown): the node's own
+    /// unknown, or with a P1 pressure the vertices it interpolates.
+    t: [[(i32, f64); 2]; 6],
     verts: [[f64; 2]; 3],
     vel: [[f64; 2]; 3],
     /// Load weights (integral of each pressure basis function over the element).
@@ -66,6 +68,60 @@ struct Element {
     linear: bool,
     /// Touches a row this rank owns.
     mine: bool,
+}
+
+/// One element's residual and Jacobian on its pressure unknowns (T^T R, T^T dR/dP T and
+/// T^T dR/dH, with T the element's pressure prolongation): rows `dofs[..n]`.
+struct Projected {
+    n: usize,
+    dofs: [i32; 6],
+    r: [f64; 6],
+    /// d r_a / d P_{dofs[b]}.
+    dp: [[f64; 6]; 6],
+    /// d r_a / d H at the element's 6 face nodes.
+    dh: [[f64; 6]; 6],
+}
+
+impl Element {
+    /// Projects the element's nodal residual and Jacobian onto its pressure unknowns.
+    fn project(&self, out: &ElementOut) -> Projected {
+        let mut pr = Projected { n: 0, dofs: [-1; 6], r: [0.0; 6], dp: [[0.0; 6]; 6], dh: [[0.0; 6]; 6] };
+        // Each node's (position among the element's unknowns, weight) entries.
+        let mut slots: [[Option<(usize, f64)>; 2]; 6] = [[None; 2]; 6];
+        for (slot, entries) in slots.iter_mut().zip(&self.t) {
+            for (m, &(d, w)) in entries.iter().enumerate() {
+                if d < 0 || w == 0.0 {
+                    continue;
+                }
+                let a = match pr.dofs[..pr.n].iter().position(|&x| x == d) {
+                    Some(a) => a,
+                    None => {
+                        pr.dofs[pr.n] = d;
+                        pr.n += 1;
+                        pr.n - 1
+                    }
+                };
+                slot[m] = Some((a, w));
+            }
+        }
+        for (i, si) in slots.iter().enumerate() {
+            for &(a, wa) in si.iter().flatten() {
+                pr.r[a] += wa * out.r[i];
+                for (k, sk) in slots.iter().enumerate() {
+                    pr.dh[a][k] += wa * out.dr_dh[i][k];
+                    for &(b, wb) in sk.iter().flatten() {
+                        pr.dp[a][b] += wa * wb * out.dr_dp[i][k];
+                    }
+                }
+            }
+        }
+        pr
+    }
+
+    /// Whether any of the element's pressure unknowns satisfies `f`.
+    fn any_dof(&self, f: impl Fn(i32) -> bool) -> bool {
+        self.t.iter().flatten().any(|&(d, w)| d >= 0 && w != 0.0 && f(d))
+    }
 }
 
 /// The block of the dense condensed Jacobian one rank fills: its rows and columns (global
@@ -175,6 +231,7 @@ impl<'a> CondensedSystem<'a> {
         let mut node_area = vec![0.0; comp.rows.len()];
         let mut elements = Vec::new();
         let linear = crate::reynolds::p1iso_pressure();
+        let p1 = crate::reynolds::p1_pressure();
         let owned = |d: i32| d >= 0 && (d as usize) >= lo && (d as usize) < hi;
         for tri in &mesh.contact_tris {
             let xz = |n: u32| {
@@ -188,29 +245,39 @@ impl<'a> CondensedSystem<'a> {
                     let verts = sub.map(|k| xz(tri[k]));
                     let area = tri_area(&verts);
                     let f6: [usize; 6] = std::array::from_fn(|i| face[sub[i.min(2)]]);
-                    let p6: [i32; 6] = std::array::from_fn(|i| if i < 3 { p[sub[i]] } else { -1 });
+                    let t: [[(i32, f64); 2]; 6] = std::array::from_fn(|i| if i < 3 { [(p[sub[i]], 1.0), (-1, 0.0)] } else { [(-1, 0.0); 2] });
                     let w: [f64; 6] = std::array::from_fn(|i| if i < 3 { area / 3.0 } else { 0.0 });
                     for i in 0..3 {
                         node_area[f6[i]] += area / 3.0;
                     }
-                    elements.push(Element { face: f6, p: p6, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w, linear: true, mine: p6.iter().any(|&d| owned(d)) });
+                    let mut e = Element { face: f6, t, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w, linear: true, mine: false };
+                    e.mine = e.any_dof(owned);
+                    elements.push(e);
                 }
                 continue;
             }
             let verts = [xz(tri[0]), xz(tri[1]), xz(tri[2])];
             let area = tri_area(&verts);
-            for &f in &face {
-                node_area[f] += area / 6.0;
+            if p1 {
+                // The P1 hat of a vertex integrates to a third of each triangle it touches.
+                for &f in &face[..3] {
+                    node_area[f] += area / 3.0;
+                }
+            } else {
+                for &f in &face {
+                    node_area[f] += area / 6.0;
+                }
             }
-            elements.push(Element {
-                face,
-                p,
-                verts,
-                vel: verts.map(|v| (params.velocity)(v[0], v[1])),
-                w: p2_tri_weights(area),
-                linear: false,
-                mine: p.iter().any(|&d| owned(d)),
+            let t: [[(i32, f64); 2]; 6] = std::array::from_fn(|k| {
+                let mut entries = [(-1, 0.0); 2];
+                for (m, (v, w)) in crate::solid::condense::pressure_of_node(k, p1).enumerate() {
+                    entries[m] = (p[v], w);
+                }
+                entries
             });
+            let mut e = Element { face, t, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w: p2_tri_weights(area), linear: false, mine: false };
+            e.mine = e.any_dof(owned);
+            elements.push(e);
         }
         let p_face: Vec<usize> = comp.cols.iter().map(|&n| layout.face_index[n as usize] as usize).collect();
         let p_area = p_face.iter().map(|&f| node_area[f]).collect();
@@ -303,8 +370,9 @@ impl<'a> CondensedSystem<'a> {
         out
     }
 
+    /// The element's 6 nodal pressures (T P on the element).
     fn element_p(x: &[f64], e: &Element) -> [f64; 6] {
-        e.p.map(|d| if d >= 0 { x[d as usize] } else { 0.0 })
+        e.t.map(|entries| entries.iter().filter(|&&(d, _)| d >= 0).map(|&(d, w)| w * x[d as usize]).sum())
     }
 
     /// Local preallocation: dense (every owned row full) with an elastic compliance;
@@ -320,14 +388,11 @@ impl<'a> CondensedSystem<'a> {
         let np = self.layout.n_p;
         let mut cols: Vec<std::collections::BTreeSet<usize>> = vec![Default::default(); hi - lo];
         for e in self.elements.iter().filter(|e| e.mine) {
-            for i in 0..6 {
-                let Some(l) = self.own_row(e.p[i]) else { continue };
+            let dofs: Vec<i32> = e.t.iter().flatten().filter(|&&(d, w)| d >= 0 && w != 0.0).map(|&(d, _)| d).collect();
+            for &r in &dofs {
+                let Some(l) = self.own_row(r) else { continue };
                 cols[l].insert(np);
-                for k in 0..6 {
-                    if e.p[k] >= 0 {
-                        cols[l].insert(e.p[k] as usize);
-                    }
-                }
+                cols[l].extend(dofs.iter().map(|&d| d as usize));
             }
         }
         if hi > np {
@@ -348,22 +413,20 @@ impl<'a> CondensedSystem<'a> {
         for e in self.elements.iter().filter(|e| e.mine) {
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
-            let out = self.eval(e, &p, &he, &fluid);
-            for i in 0..6 {
-                let Some(_) = self.own_row(e.p[i]) else { continue };
-                let r = e.p[i] as usize;
+            let pr = e.project(&self.eval(e, &p, &he, &fluid));
+            for a in 0..pr.n {
+                let Some(_) = self.own_row(pr.dofs[a]) else { continue };
+                let r = pr.dofs[a] as usize;
                 let s = self.row_scale[r];
                 let mut cols = Vec::with_capacity(7);
                 let mut vals = Vec::with_capacity(7);
-                for k in 0..6 {
-                    if e.p[k] >= 0 {
-                        cols.push(e.p[k]);
-                        vals.push(s * out.dr_dp[i][k]);
-                    }
+                for b in 0..pr.n {
+                    cols.push(pr.dofs[b]);
+                    vals.push(s * pr.dp[a][b]);
                 }
                 // dH/dH0 = 1 at every node.
                 cols.push(np as i32);
-                vals.push(s * out.dr_dh[i].iter().sum::<f64>());
+                vals.push(s * pr.dh[a].iter().sum::<f64>());
                 j.add_values(&[r as i32], &cols, &vals)?;
             }
         }
@@ -376,7 +439,7 @@ impl<'a> CondensedSystem<'a> {
                 j.add_values(&[np as i32], &[np as i32], &[1.0])?;
             } else {
                 for e in &self.elements {
-                    let (cols, vals): (Vec<i32>, Vec<f64>) = (0..6).filter(|&k| e.p[k] >= 0).map(|k| (e.p[k], e.w[k])).unzip();
+                    let (cols, vals): (Vec<i32>, Vec<f64>) = (0..6).flat_map(|k| e.t[k].iter().filter(|&&(d, w)| d >= 0 && w != 0.0).map(move |&(d, w)| (d, w * e.w[k]))).unzip();
                     j.add_values(&[np as i32], &cols, &vals)?;
                 }
             }
@@ -441,11 +504,9 @@ impl EhlProblem for CondensedSystem<'_> {
         for e in &self.elements {
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
-            let out = self.eval(e, &p, &he, &fluid);
-            for i in 0..6 {
-                if e.p[i] >= 0 {
-                    diag[e.p[i] as usize] += out.dr_dp[i][i].abs();
-                }
+            let pr = e.project(&self.eval(e, &p, &he, &fluid));
+            for a in 0..pr.n {
+                diag[pr.dofs[a] as usize] += pr.dp[a][a].abs();
             }
         }
         for (j, d) in diag.iter().enumerate().take(self.layout.n_p) {
@@ -492,10 +553,10 @@ impl Problem for CondensedSystem<'_> {
         for e in self.elements.iter().filter(|e| e.mine) {
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
-            let out = self.eval(e, &p, &he, &fluid);
-            for i in 0..6 {
-                if let Some(l) = self.own_row(e.p[i]) {
-                    r[l] += out.r[i];
+            let pr = e.project(&self.eval(e, &p, &he, &fluid));
+            for a in 0..pr.n {
+                if let Some(l) = self.own_row(pr.dofs[a]) {
+                    r[l] += pr.r[a];
                 }
             }
         }
@@ -581,21 +642,23 @@ impl Problem for CondensedSystem<'_> {
         let mut buf = vec![0.0; fb.rows.len() * ncl];
         let h0_col = fb.col_of(np as i32);
         for e in &self.elements {
-            if !e.p.iter().any(|&d| fb.row_of(d).is_some()) {
+            if !e.any_dof(|d| fb.row_of(d).is_some()) {
                 continue;
             }
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
-            let out = self.eval(e, &p, &he, &fluid);
-            for i in 0..6 {
-                let Some(l) = fb.row_of(e.p[i]) else { continue };
+            let pr = e.project(&self.eval(e, &p, &he, &fluid));
+            for a in 0..pr.n {
+                let Some(l) = fb.row_of(pr.dofs[a]) else { continue };
                 let row = &mut buf[l * ncl..(l + 1) * ncl];
-                for k in 0..6 {
-                    if let Some(c) = fb.col_of(e.p[k]) {
-                        row[c] += out.dr_dp[i][k];
+                for b in 0..pr.n {
+                    if let Some(c) = fb.col_of(pr.dofs[b]) {
+                        row[c] += pr.dp[a][b];
                     }
+                }
+                for k in 0..6 {
                     // H = H0 + gap - U_y with U_y = C P: dH/dP = -C, dH/dH0 = 1.
-                    let g = out.dr_dh[i][k];
+                    let g = pr.dh[a][k];
                     if g != 0.0 {
                         if !self.comp.is_rigid() {
                             for (a, c) in row.iter_mut().zip(fb.c_row(self.comp, e.face[k])) {
@@ -640,8 +703,10 @@ impl Problem for CondensedSystem<'_> {
             let row = &mut buf[l * ncl..(l + 1) * ncl];
             for e in &self.elements {
                 for k in 0..6 {
-                    if let Some(c) = fb.col_of(e.p[k]) {
-                        row[c] += e.w[k];
+                    for &(d, w) in &e.t[k] {
+                        if let Some(c) = fb.col_of(d) {
+                            row[c] += w * e.w[k];
+                        }
                     }
                 }
             }

@@ -189,7 +189,7 @@ impl<'a> EhlSolver<'a> {
         }
         let t0 = std::time::Instant::now();
         let rigid = scene.effects.elasticity == crate::case::ElasticityModel::Rigid;
-        let p_nodes: Vec<u32> = mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect();
+        let p_nodes = pressure_nodes(mesh, layout);
         let comp = if rigid {
             ctx.log(format!("rigid solids: no elastic unknowns, H = H0 + (X^2 + Z^2)/2; sparse Newton on {} pressure unknowns", p_nodes.len()));
             Some(crate::solid::condense::Compliance::rigid(mesh.contact_nodes.clone(), p_nodes))
@@ -236,6 +236,19 @@ impl<'a> EhlSolver<'a> {
 #[allow(clippy::too_many_arguments)]
 pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
     EhlSolver::new(ctx, scene, mesh, part, dofs, layout, half)?.solve(ctx, scene, None)
+}
+
+/// The face nodes that carry a pressure unknown in the condensed system, in
+/// `mesh.contact_nodes` order: every P2 node off the Dirichlet edges, or with a P1 pressure
+/// ([`crate::reynolds::p1_pressure`]) the triangles' vertices among them.
+fn pressure_nodes(mesh: &Mesh, layout: &Layout) -> Vec<u32> {
+    let mut vertex = vec![!crate::reynolds::p1_pressure(); mesh.nodes.len()];
+    for tri in &mesh.contact_tris {
+        for &n in &tri[..3] {
+            vertex[n as usize] = true;
+        }
+    }
+    mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0 && vertex[n as usize]).collect()
 }
 
 /// Options prefix of the condensed Newton Jacobian (`-condensed_mat_type aij` with
@@ -298,6 +311,20 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     let mut x = vec![0.0; layout.total()];
     for (j, &n) in comp.cols.iter().enumerate() {
         x[layout.p[n as usize] as usize] = out.x[j];
+    }
+    if crate::reynolds::p1_pressure() {
+        // P1 pressure: the mid-side nodes take the mean of their edge's vertices (0 on the
+        // Dirichlet edges), the P2 field the rest of the code reads.
+        for tri in &mesh.contact_tris {
+            for (e, [a, b]) in crate::fem::p2tri::TRI_EDGES.iter().enumerate() {
+                let d = layout.p[tri[3 + e] as usize];
+                if d >= 0 {
+                    let v = |n: u32| Layout::value(&x, layout.p[n as usize]);
+                    let mean = 0.5 * (v(tri[*a]) + v(tri[*b]));
+                    x[d as usize] = mean;
+                }
+            }
+        }
     }
     for (i, &n) in comp.rows.iter().enumerate() {
         let d = layout.u[n as usize][1];
