@@ -35,6 +35,10 @@ pub fn mesh_spec(scene: &Scene, half_z: bool) -> mesh::MeshSpec {
             outer: scene.mesh.ring_outer,
             size: scene.mesh.ring_size,
         }),
+        patch: (scene.mesh.patch_size > 0.0).then(|| {
+            let m = &scene.mesh;
+            (mesh::Rect { x0: m.patch_x_min, x1: m.patch_x_max, z0: m.patch_z_min, z1: m.patch_z_max }, m.patch_size)
+        }),
     }
 }
 

@@ -192,6 +192,17 @@ impl Scene {
                 format!("must exceed mesh.ring_inner = {} (units of a)", fmt_num(m.ring_inner)),
             ));
         }
+        if m.patch_size > 0.0 {
+            for (lo, hi, axis) in [(m.patch_x_min, m.patch_x_max, "x"), (m.patch_z_min, m.patch_z_max, "z")] {
+                if hi <= lo {
+                    return Err(not_allowed(
+                        &format!("mesh.patch_{axis}_max"),
+                        hi,
+                        format!("must exceed mesh.patch_{axis}_min = {} (units of a) when mesh.patch_size > 0", fmt_num(lo)),
+                    ));
+                }
+            }
+        }
 
         let e = &self.effects;
         if let Some(l) = &self.lubricant {

@@ -693,6 +693,14 @@ pub struct MeshSettings {
     pub ring_inner: f64,
     /// Outer radius of the ring (units of a), default 1.25.
     pub ring_outer: f64,
+    /// Element size in the patch rectangle patch_x_min <= X <= patch_x_max,
+    /// patch_z_min <= Z <= patch_z_max (units of a); 0 (default): no patch.
+    pub patch_size: f64,
+    /// Patch rectangle (units of a); with patch_size > 0, min < max on both axes.
+    pub patch_x_min: f64,
+    pub patch_x_max: f64,
+    pub patch_z_min: f64,
+    pub patch_z_max: f64,
 }
 
 impl Default for MeshSettings {
@@ -706,6 +714,11 @@ impl Default for MeshSettings {
             ring_size: 0.0,
             ring_inner: 0.75,
             ring_outer: 1.25,
+            patch_size: 0.0,
+            patch_x_min: 0.0,
+            patch_x_max: 0.0,
+            patch_z_min: 0.0,
+            patch_z_max: 0.0,
         }
     }
 }
@@ -775,6 +788,17 @@ pub const MESH_FIELDS: &[Field] = &[
         Kind::Number(Range::LeftOpen(0.0, 8.0)),
         Presence::Default("1.25")
     ),
+    f!(
+        "patch_size",
+        "element size in the patch rectangle, e.g. around an outlet constriction or a spin pole (rounded down to 16/2^k; 0: no patch)",
+        "a",
+        Kind::Number(Range::Closed(0.0, 16.0)),
+        Presence::Default("0")
+    ),
+    f!("patch_x_min", "patch rectangle: lowest X", "a", Kind::Number(Range::Closed(-8.0, 8.0)), Presence::Default("0")),
+    f!("patch_x_max", "patch rectangle: highest X (must exceed patch_x_min when patch_size > 0)", "a", Kind::Number(Range::Closed(-8.0, 8.0)), Presence::Default("0")),
+    f!("patch_z_min", "patch rectangle: lowest Z", "a", Kind::Number(Range::Closed(-8.0, 8.0)), Presence::Default("0")),
+    f!("patch_z_max", "patch rectangle: highest Z (must exceed patch_z_min when patch_size > 0)", "a", Kind::Number(Range::Closed(-8.0, 8.0)), Presence::Default("0")),
 ];
 
 // ---------------------------------------------------------------------------------------

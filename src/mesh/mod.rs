@@ -9,7 +9,8 @@
 //! 2. Kuhn triangulation (6 tets per box, same orientation everywhere);
 //! 3. Maubach newest-vertex bisection of every tet whose longest edge exceeds
 //!    `sqrt(3) h(d)`, `h(d) = h_c + g d`, `d` = distance of its bounding box
-//!    to the contact rectangle, followed by conformity closure;
+//!    to the contact rectangle, followed by conformity closure; the optional core
+//!    square, ring and patch lower `h(d)` near them the same way;
 //! 4. P2 nodes at the edge midpoints (straight-sided), contact triangles and
 //!    boundary flags.
 //!
@@ -80,6 +81,7 @@ fn refined_bisector(spec: &MeshSpec, h: f64) -> refine::Bisector {
     let dyadic = spec::dyadic_size;
     let core = spec.core.map(|(c, size)| ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], dyadic(size)));
     let ring = spec.ring.map(|r| (r.inner, r.outer, dyadic(r.size)));
+    let patch = spec.patch.map(|(c, size)| ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], dyadic(size)));
     b.refine_and_close(|v, t| {
         let d = refine::bbox_distance(v, t, &rlo, &rhi);
         let mut target = h + g * d;
@@ -88,6 +90,9 @@ fn refined_bisector(spec: &MeshSpec, h: f64) -> refine::Bisector {
         }
         if let Some((r0, r1, hr)) = ring {
             target = target.min(hr + g * refine::ring_distance(v, t, r0, r1));
+        }
+        if let Some((lo, hi, hp)) = &patch {
+            target = target.min(hp + g * refine::bbox_distance(v, t, lo, hi));
         }
         refine::longest_edge(v, t) > 3f64.sqrt() * target * (1.0 + 1e-10)
     });

@@ -65,6 +65,11 @@ pub struct MeshSpec {
     /// It follows the Hertz circle, where the inlet build-up, the side lobes and the
     /// outlet spike sit.
     pub ring: Option<Ring>,
+    /// Optional finer patch: a rectangle of the top face (it may reach outside `contact`)
+    /// meshed with size `patch.1` (rounded down to 16/2^k), grading away from it at the same
+    /// growth. For a feature that is small and placed: the outlet constriction, the film
+    /// next to a spin pole.
+    pub patch: Option<(Rect, f64)>,
 }
 
 /// An annulus on the top face, centred on the origin, with its element size.
@@ -92,6 +97,7 @@ impl MeshSpec {
             growth: 0.5,
             core: None,
             ring: None,
+            patch: None,
         }
     }
 
@@ -159,6 +165,13 @@ impl MeshSpec {
                     "mesh spec: ring radii must satisfy 0 <= inner < outer (got inner {}, outer {})",
                     r.inner, r.outer
                 ));
+            }
+        }
+        if let Some((r, size)) = self.patch {
+            pos("patch size", size)?;
+            let vals = [r.x0, r.x1, r.z0, r.z1];
+            if vals.iter().any(|v| !v.is_finite()) || r.x0 >= r.x1 || r.z0 >= r.z1 {
+                return Err(format!("mesh spec: patch rectangle {r:?} is empty or not finite"));
             }
         }
         if self.contact_size < COARSE_CELL / f64::from(1u32 << MAX_LEVEL) {

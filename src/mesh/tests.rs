@@ -497,3 +497,39 @@ fn ring_refines_only_around_the_hertz_circle() {
     }
     assert!(in_ring > 500 && centre > 0, "{in_ring} {centre}");
 }
+
+#[test]
+fn patch_refines_only_its_rectangle() {
+    // Half domain, h_c = 0.25, a 0.03125 patch on -0.4 <= X <= 0.4, -1.02 <= Z <= -0.94
+    // (a thin outlet constriction): triangles touching it have legs <= 0.03125, triangles
+    // more than 0.25 away from it are coarser, and the mesh outside stays conforming.
+    let mut s = half_spec();
+    let r = Rect { x0: -0.4, x1: 0.4, z0: -1.02, z1: -0.94 };
+    s.patch = Some((r, 0.03125));
+    let m = generate(&s).unwrap();
+    check_conformity(&m);
+    check_no_hanging(&m);
+    check_p2(&m);
+    check_flags(&m);
+    assert!(rel_close(m.top_face_area_in_contact(), s.contact.area(), 1e-12));
+    let (mut inside, mut far) = (0, 0);
+    let fine = 0.03125 * 2f64.sqrt() * (1.0 + 1e-12);
+    for c in &m.contact_tris {
+        let p: Vec<[f64; 3]> = c[..3].iter().map(|&v| m.nodes[v as usize]).collect();
+        let edge = |a: usize, b: usize| ((p[a][0] - p[b][0]).powi(2) + (p[a][2] - p[b][2]).powi(2)).sqrt();
+        let longest = edge(0, 1).max(edge(1, 2)).max(edge(2, 0));
+        let (x0, x1) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| (a.min(q[0]), b.max(q[0])));
+        let (z0, z1) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| (a.min(q[2]), b.max(q[2])));
+        let gap = (r.x0 - x1).max(x0 - r.x1).max(0.0).hypot((r.z0 - z1).max(z0 - r.z1).max(0.0));
+        if gap == 0.0 {
+            assert!(longest <= fine, "triangle touching the patch has edge {longest}");
+            inside += 1;
+        } else if gap > 0.25 {
+            assert!(longest > fine, "triangle {gap} away from the patch has edge {longest}");
+            far += 1;
+        }
+    }
+    // The patch holds 0.8 x 0.08 / (0.03125^2 / 2) = 131 triangles at least.
+    assert!(inside >= 131 && far > 100, "{inside} {far}");
+}
+
