@@ -79,20 +79,18 @@ fn refined_bisector(spec: &MeshSpec, h: f64) -> refine::Bisector {
     let (rlo, rhi) = ([r.x0, 0.0, r.z0], [r.x1, 0.0, r.z1]);
     let g = spec.growth;
     let dyadic = spec::dyadic_size;
-    let core = spec.core.map(|(c, size)| ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], dyadic(size)));
+    // Rectangle refinements (the core square and the patch): bounding box and size.
+    let boxes: Vec<([f64; 3], [f64; 3], f64)> =
+        spec.core.iter().chain(&spec.patch).map(|&(c, size)| ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], dyadic(size))).collect();
     let ring = spec.ring.map(|r| (r.inner, r.outer, dyadic(r.size)));
-    let patch = spec.patch.map(|(c, size)| ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], dyadic(size)));
     b.refine_and_close(|v, t| {
         let d = refine::bbox_distance(v, t, &rlo, &rhi);
         let mut target = h + g * d;
-        if let Some((lo, hi, hc)) = &core {
-            target = target.min(hc + g * refine::bbox_distance(v, t, lo, hi));
+        for (lo, hi, hb) in &boxes {
+            target = target.min(hb + g * refine::bbox_distance(v, t, lo, hi));
         }
         if let Some((r0, r1, hr)) = ring {
             target = target.min(hr + g * refine::ring_distance(v, t, r0, r1));
-        }
-        if let Some((lo, hi, hp)) = &patch {
-            target = target.min(hp + g * refine::bbox_distance(v, t, lo, hi));
         }
         refine::longest_edge(v, t) > 3f64.sqrt() * target * (1.0 + 1e-10)
     });

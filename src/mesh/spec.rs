@@ -37,6 +37,11 @@ impl Rect {
         (self.x1 - self.x0) * (self.z1 - self.z0)
     }
 
+    /// True if every edge is finite and the rectangle has a positive width along x and z.
+    pub fn is_proper(&self) -> bool {
+        [self.x0, self.x1, self.z0, self.z1].iter().all(|v| v.is_finite()) && self.x0 < self.x1 && self.z0 < self.z1
+    }
+
     /// True if `(x, z)` lies in the rectangle enlarged by `tol` on each side.
     pub fn contains(&self, x: f64, z: f64, tol: f64) -> bool {
         x >= self.x0 - tol && x <= self.x1 + tol && z >= self.z0 - tol && z <= self.z1 + tol
@@ -169,8 +174,7 @@ impl MeshSpec {
         }
         if let Some((r, size)) = self.patch {
             pos("patch size", size)?;
-            let vals = [r.x0, r.x1, r.z0, r.z1];
-            if vals.iter().any(|v| !v.is_finite()) || r.x0 >= r.x1 || r.z0 >= r.z1 {
+            if !r.is_proper() {
                 return Err(format!("mesh spec: patch rectangle {r:?} is empty or not finite"));
             }
         }
@@ -189,8 +193,7 @@ impl MeshSpec {
     /// Kuhn grid of spacing `h`.
     fn validate_rect(&self, h: f64) -> Result<(), String> {
         let r = self.contact;
-        let vals = [r.x0, r.x1, r.z0, r.z1];
-        if vals.iter().any(|v| !v.is_finite()) || r.x0 >= r.x1 || r.z0 >= r.z1 {
+        if !r.is_proper() {
             return Err(format!(
                 "mesh spec: contact rectangle {r:?} is empty or not finite"
             ));
@@ -204,7 +207,7 @@ impl MeshSpec {
                 lo[0], hi[0], lo[2], hi[2]
             ));
         }
-        for v in vals {
+        for v in [r.x0, r.x1, r.z0, r.z1] {
             if !on_dyadic_grid(v, h) {
                 return Err(format!(
                     "mesh spec: contact rectangle edge {v} is not a multiple of the actual \

@@ -207,6 +207,16 @@ fn check_flags(m: &Mesh) {
     assert!(m.clamped.iter().any(|&c| c));
 }
 
+/// The structural checks of a mesh whose contact face is refined locally (a ring or a
+/// patch; no uniform grid over the rectangle): the triangles still tile it.
+fn check_graded(m: &Mesh) {
+    check_conformity(m);
+    check_no_hanging(m);
+    check_p2(m);
+    check_flags(m);
+    assert!(rel_close(m.top_face_area_in_contact(), m.spec.contact.area(), 1e-12));
+}
+
 /// All structural checks.
 fn check_all(m: &Mesh) {
     check_conformity(m);
@@ -472,11 +482,7 @@ fn ring_refines_only_around_the_hertz_circle() {
     let mut s = half_spec();
     s.ring = Some(Ring { inner: 0.85, outer: 1.15, size: 0.0625 });
     let m = generate(&s).unwrap();
-    check_conformity(&m);
-    check_no_hanging(&m);
-    check_p2(&m);
-    check_flags(&m);
-    assert!(rel_close(m.top_face_area_in_contact(), s.contact.area(), 1e-12));
+    check_graded(&m);
     let (mut in_ring, mut centre) = (0, 0);
     for c in &m.contact_tris {
         let p: Vec<[f64; 3]> = c[..3].iter().map(|&v| m.nodes[v as usize]).collect();
@@ -507,11 +513,7 @@ fn patch_refines_only_its_rectangle() {
     let r = Rect { x0: -0.4, x1: 0.4, z0: -1.02, z1: -0.94 };
     s.patch = Some((r, 0.03125));
     let m = generate(&s).unwrap();
-    check_conformity(&m);
-    check_no_hanging(&m);
-    check_p2(&m);
-    check_flags(&m);
-    assert!(rel_close(m.top_face_area_in_contact(), s.contact.area(), 1e-12));
+    check_graded(&m);
     let (mut inside, mut far) = (0, 0);
     let fine = 0.03125 * 2f64.sqrt() * (1.0 + 1e-12);
     for c in &m.contact_tris {
