@@ -88,11 +88,8 @@ impl Element {
         let mut pr = Projected { n: 0, dofs: [-1; 6], r: [0.0; 6], dp: [[0.0; 6]; 6], dh: [[0.0; 6]; 6] };
         // Each node's (position among the element's unknowns, weight) entries.
         let mut slots: [[Option<(usize, f64)>; 2]; 6] = [[None; 2]; 6];
-        for (slot, entries) in slots.iter_mut().zip(&self.t) {
-            for (m, &(d, w)) in entries.iter().enumerate() {
-                if d < 0 || w == 0.0 {
-                    continue;
-                }
+        for (k, slot) in slots.iter_mut().enumerate() {
+            for (m, (d, w)) in self.entries(k).enumerate() {
                 let a = match pr.dofs[..pr.n].iter().position(|&x| x == d) {
                     Some(a) => a,
                     None => {
@@ -118,9 +115,21 @@ impl Element {
         pr
     }
 
+    /// The (pressure unknown, weight) entries local node `k` takes its pressure from,
+    /// without the padding and the Dirichlet edges' missing unknowns.
+    fn entries(&self, k: usize) -> impl Iterator<Item = (i32, f64)> + '_ {
+        self.t[k].iter().copied().filter(|&(d, w)| d >= 0 && w != 0.0)
+    }
+
+    /// The element's pressure unknowns, node by node (an unknown shared by several nodes
+    /// appears once per node).
+    fn dofs(&self) -> impl Iterator<Item = i32> + '_ {
+        (0..6).flat_map(|k| self.entries(k).map(|(d, _)| d))
+    }
+
     /// Whether any of the element's pressure unknowns satisfies `f`.
     fn any_dof(&self, f: impl Fn(i32) -> bool) -> bool {
-        self.t.iter().flatten().any(|&(d, w)| d >= 0 && w != 0.0 && f(d))
+        self.dofs().any(f)
     }
 }
 
@@ -372,7 +381,7 @@ impl<'a> CondensedSystem<'a> {
 
     /// The element's 6 nodal pressures (T P on the element).
     fn element_p(x: &[f64], e: &Element) -> [f64; 6] {
-        e.t.map(|entries| entries.iter().filter(|&&(d, _)| d >= 0).map(|&(d, w)| w * x[d as usize]).sum())
+        std::array::from_fn(|k| e.entries(k).map(|(d, w)| w * x[d as usize]).sum())
     }
 
     /// Local preallocation: dense (every owned row full) with an elastic compliance;
@@ -388,7 +397,7 @@ impl<'a> CondensedSystem<'a> {
         let np = self.layout.n_p;
         let mut cols: Vec<std::collections::BTreeSet<usize>> = vec![Default::default(); hi - lo];
         for e in self.elements.iter().filter(|e| e.mine) {
-            let dofs: Vec<i32> = e.t.iter().flatten().filter(|&&(d, w)| d >= 0 && w != 0.0).map(|&(d, _)| d).collect();
+            let dofs: Vec<i32> = e.dofs().collect();
             for &r in &dofs {
                 let Some(l) = self.own_row(r) else { continue };
                 cols[l].insert(np);
@@ -439,7 +448,7 @@ impl<'a> CondensedSystem<'a> {
                 j.add_values(&[np as i32], &[np as i32], &[1.0])?;
             } else {
                 for e in &self.elements {
-                    let (cols, vals): (Vec<i32>, Vec<f64>) = (0..6).flat_map(|k| e.t[k].iter().filter(|&&(d, w)| d >= 0 && w != 0.0).map(move |&(d, w)| (d, w * e.w[k]))).unzip();
+                    let (cols, vals): (Vec<i32>, Vec<f64>) = (0..6).flat_map(|k| e.entries(k).map(move |(d, w)| (d, w * e.w[k]))).unzip();
                     j.add_values(&[np as i32], &cols, &vals)?;
                 }
             }

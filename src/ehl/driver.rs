@@ -316,12 +316,11 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
         // P1 pressure: the mid-side nodes take the mean of their edge's vertices (0 on the
         // Dirichlet edges), the P2 field the rest of the code reads.
         for tri in &mesh.contact_tris {
-            for (e, [a, b]) in crate::fem::p2tri::TRI_EDGES.iter().enumerate() {
-                let d = layout.p[tri[3 + e] as usize];
+            for k in 3..6 {
+                let d = layout.p[tri[k] as usize];
                 if d >= 0 {
                     let v = |n: u32| Layout::value(&x, layout.p[n as usize]);
-                    let mean = 0.5 * (v(tri[*a]) + v(tri[*b]));
-                    x[d as usize] = mean;
+                    x[d as usize] = crate::solid::condense::pressure_of_node(k, true).map(|(i, w)| w * v(tri[i])).sum();
                 }
             }
         }
