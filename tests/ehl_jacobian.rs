@@ -9,10 +9,11 @@ fn ehl_jacobian_matches_finite_differences() {
     let scene = table2_ue2_with_mesh("contact_size = 1.0\ngrowth = 2.0");
     let path = write_scene(&dir, "scene.toml", &scene);
     let mut cmd = std::process::Command::new("mpirun");
-    cmd.args(["-n", "2"]).arg(binary()).args([path.as_str(), "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "0"]);
-    cmd.env("EHL_CHECK_JACOBIAN", "1").env("EHL_MONOLITHIC", "1").env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OPENBLAS_NUM_THREADS", "1");
+    cmd.args(["-n", "2"]).arg(binary()).args([path.as_str(), "--set", "reynolds.coupling=monolithic", "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "0"]);
+    cmd.env("EHL_CHECK_JACOBIAN", "1").env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OPENBLAS_NUM_THREADS", "1");
     let out = cmd.output().unwrap();
     let t = text(&out);
+    assert!(t.contains("coupling: monolithic"), "{t}");
     let lines: Vec<&str> = t.lines().filter(|l| l.contains("Jacobian check")).collect();
     assert_eq!(lines.len(), 9, "expected 9 block checks:\n{t}");
     for l in &lines {
@@ -67,13 +68,13 @@ fn newton_norms_on(tag: &str, monolithic: bool, ranks: usize) -> Vec<f64> {
     let scene = table2_ue2_with_mesh("contact_size = 1.0\ngrowth = 2.0");
     let path = write_scene(&dir, "scene.toml", &scene);
     let mut cmd = std::process::Command::new("mpirun");
-    cmd.args(["-n", &ranks.to_string()]).arg(binary()).args([path.as_str(), "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "3", "-snes_monitor"]);
+    let coupling = if monolithic { "reynolds.coupling=monolithic" } else { "reynolds.coupling=condensed" };
+    cmd.args(["-n", &ranks.to_string()]).arg(binary()).args([path.as_str(), "--set", coupling, "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "3", "-snes_monitor"]);
     cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OMPI_MCA_rmaps_base_oversubscribe", "1").env("OPENBLAS_NUM_THREADS", "1");
-    if monolithic {
-        cmd.env("EHL_MONOLITHIC", "1");
-    }
     let out = cmd.output().unwrap();
     let t = text(&out);
+    let used = if monolithic { "coupling: monolithic" } else { "coupling: condensed" };
+    assert!(t.contains(used), "the run did not use the requested coupling ({used}):\n{t}");
     t.lines().filter(|l| l.contains("SNES Function norm")).map(|l| l.rsplit(' ').find(|w| !w.is_empty()).unwrap().parse().unwrap()).collect()
 }
 

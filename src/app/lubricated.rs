@@ -77,7 +77,7 @@ pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
     let mut simulated = vec![format!("Reynolds equation (P2, {} stabilisation) with the load balance for h0", scene.reynolds.stabilisation)];
     let mut skipped = Vec::new();
     match e.elasticity {
-        crate::case::ElasticityModel::Elastic => simulated.push("elastic deformation: P2 equivalent cube, condensed onto the contact face".into()),
+        crate::case::ElasticityModel::Elastic => simulated.push("elastic deformation: P2 equivalent cube (reynolds.coupling: condensed onto the contact face or monolithic)".into()),
         crate::case::ElasticityModel::Rigid => skipped.push("elastic deformation and the 3D mesh (effects.elasticity = \"rigid\")".into()),
     }
     simulated.push(match e.viscosity {
@@ -265,7 +265,7 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
             "newton_iterations": sol.newton_total, "snes_reason": sol.report.reason,
             "residual_norm": sol.report.residual_norm,
             "dofs_elastic": n_u, "dofs_reynolds": n_p, "path": sol.steps, "half_domain": setup.half,
-            "penalty": scene.reynolds.penalty, "stabilisation": scene.reynolds.stabilisation.as_str(),
+            "penalty": scene.reynolds.penalty, "stabilisation": scene.reynolds.stabilisation.as_str(), "coupling": sol.coupling,
         },
         "timing": { "mesh_s": setup.mesh_s, "assembly_s": sol.assembly_s, "solve_s": sol.solve_s, "post_s": t_post.elapsed().as_secs_f64(), "total_s": ctx.start.elapsed().as_secs_f64() },
         "peak_rss_mb": peak,

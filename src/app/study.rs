@@ -160,7 +160,10 @@ struct Level {
     n_p: usize,
     its: usize,
     mesh_s: f64,
-    condensation_s: f64,
+    /// The elastic condensation (condensed coupling), or the stiffness assembly and the
+    /// dry start (monolithic coupling).
+    setup_s: f64,
+    coupling: &'static str,
     newton_s: f64,
     total_s: f64,
     rss_mb: f64,
@@ -187,7 +190,7 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
         let solved = solver.solve(ctx, &sc, None).and_then(|sol| collective::agree(&ctx.world, post_point(ctx, &sc, &setup, &sol, solver.condensation_s, &dir)).map(|r| (sol, r)));
         let rss_mb = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
         let level = match solved {
-            Ok((sol, r)) => Level { failed: None, h, n_u, n_p, its: sol.newton_total, mesh_s: setup.mesh_s, condensation_s: solver.condensation_s.unwrap_or(0.0), newton_s: sol.solve_s, total_s: t0.elapsed().as_secs_f64(), rss_mb, r },
+            Ok((sol, r)) => Level { failed: None, h, n_u, n_p, its: sol.newton_total, mesh_s: setup.mesh_s, setup_s: solver.condensation_s.unwrap_or(sol.assembly_s), coupling: solver.coupling(), newton_s: sol.solve_s, total_s: t0.elapsed().as_secs_f64(), rss_mb, r },
             Err(e) => {
                 // A level too coarse for the load fails honestly: recorded, skipped, the
                 // ladder goes on.
@@ -198,7 +201,7 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
                 if crate::interrupt::agreed() != 0 {
                     return Err(e);
                 }
-                Level { failed: Some(e), h, n_u, n_p, its: 0, mesh_s: setup.mesh_s, condensation_s: solver.condensation_s.unwrap_or(0.0), newton_s: 0.0, total_s: t0.elapsed().as_secs_f64(), rss_mb, r: PointResult::default() }
+                Level { failed: Some(e), h, n_u, n_p, its: 0, mesh_s: setup.mesh_s, setup_s: solver.condensation_s.unwrap_or(0.0), coupling: solver.coupling(), newton_s: 0.0, total_s: t0.elapsed().as_secs_f64(), rss_mb, r: PointResult::default() }
             }
         };
         rows.push(level);
@@ -233,13 +236,13 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level]) -> Result<(), Stri
     let refs: Vec<(f64, Option<f64>)> = quantities.iter().map(|(_, q)| richardson(q).map(|(v, p)| (v, Some(p))).unwrap_or((*q.last().unwrap(), None))).collect();
     let err = |qi: usize, k: usize| (quantities[qi].1[k] - refs[qi].0).abs() / refs[qi].0.abs();
     // CSV
-    let mut csv = String::from("level,h_a,dofs_elastic,dofs_reynolds,newton_iterations,mesh_s,condensation_s,newton_s,total_s,peak_rss_mb");
+    let mut csv = String::from("level,h_a,dofs_elastic,dofs_reynolds,coupling,newton_iterations,mesh_s,setup_s,newton_s,total_s,peak_rss_mb");
     for (name, _) in &quantities {
         csv.push_str(&format!(",{name},{name}_rel_error"));
     }
     csv.push('\n');
     for (k, r) in rows.iter().enumerate() {
-        csv.push_str(&format!("{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.0}", level_no(r), r.h, r.n_u, r.n_p, r.its, r.mesh_s, r.condensation_s, r.newton_s, r.total_s, r.rss_mb));
+        csv.push_str(&format!("{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.0}", level_no(r), r.h, r.n_u, r.n_p, r.coupling, r.its, r.mesh_s, r.setup_s, r.newton_s, r.total_s, r.rss_mb));
         for (qi, (_, q)) in quantities.iter().enumerate() {
             csv.push_str(&format!(",{:e},{:e}", q[k], err(qi, k)));
         }
@@ -248,13 +251,13 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level]) -> Result<(), Stri
     let path = ctx.out_dir.join("study.csv");
     crate::output::write_atomic(&path, csv.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     // Markdown
-    let mut md = format!("# Convergence study: {} ({} ranks)\n\n| level | h (a) | elastic unknowns | pressure unknowns | Newton its | mesh + condensation + Newton = total (s) | peak RSS/rank (MB) |", scene.name, ctx.size);
+    let mut md = format!("# Convergence study: {} ({} ranks)\n\n| level | h (a) | elastic unknowns | pressure unknowns | coupling | Newton its | mesh + setup + Newton = total (s) | peak RSS/rank (MB) |", scene.name, ctx.size);
     for (name, _) in &quantities {
         md.push_str(&format!(" {name} | error |"));
     }
-    md.push_str(&format!("\n|{}\n", "---|".repeat(7 + 2 * quantities.len())));
+    md.push_str(&format!("\n|{}\n", "---|".repeat(8 + 2 * quantities.len())));
     for (k, r) in rows.iter().enumerate() {
-        md.push_str(&format!("| {} | {} | {} | {} | {} | {:.1} + {:.1} + {:.1} = {:.1} | {:.0} |", level_no(r), r.h, r.n_u, r.n_p, r.its, r.mesh_s, r.condensation_s, r.newton_s, r.total_s, r.rss_mb));
+        md.push_str(&format!("| {} | {} | {} | {} | {} | {} | {:.1} + {:.1} + {:.1} = {:.1} | {:.0} |", level_no(r), r.h, r.n_u, r.n_p, r.coupling, r.its, r.mesh_s, r.setup_s, r.newton_s, r.total_s, r.rss_mb));
         for (qi, (_, q)) in quantities.iter().enumerate() {
             md.push_str(&format!(" {:.5e} | {:.2} % |", q[k], 100.0 * err(qi, k)));
         }

@@ -588,6 +588,26 @@ choice_enum! {
     } default = Supg
 }
 
+choice_enum! {
+    /// `reynolds.coupling`: how Newton's linear systems couple the film to the solid.
+    pub enum Coupling {
+        /// "condensed" up to [`AUTO_MONOLITHIC_ABOVE`] pressure unknowns, "monolithic" above.
+        Auto = "auto",
+        /// The elastic block eliminated once onto the contact face (a dense face
+        /// compliance); Newton on (P, H0) with a dense LU: fastest on small meshes, but
+        /// its cost grows as the cube of the pressure unknowns.
+        Condensed = "condensed",
+        /// U, P and H0 in one sparse matrix, factorised by MUMPS at every Newton step.
+        Monolithic = "monolithic",
+    } default = Auto
+}
+
+/// `reynolds.coupling = "auto"` solves the monolithic system above this many pressure
+/// unknowns. Measured on table2-ue2 (2 ranks, README "Coupling"): at 3,220 pressure
+/// unknowns the condensed solve takes 13.7 s and the monolithic 16.9 s, at 4,824 they take
+/// 32 s and 25 s, at 11,040 681 s and 83 s.
+pub const AUTO_MONOLITHIC_ABOVE: usize = 4000;
+
 /// Default dimensionless cavitation penalty factor xi.
 pub const DEFAULT_PENALTY: f64 = 1e4;
 
@@ -622,6 +642,9 @@ pub struct ReynoldsDomain {
     /// delta_CD = 0.1 on table2-ue2, but it also smears the side lobes of a heavily loaded
     /// contact (hm -9.5 % at 2 GPa), so the default is 0 (README "Crosswind diffusion").
     pub crosswind_diffusion: f64,
+    /// "auto" | "condensed" | "monolithic"; default "auto" (condensed up to 4,000 pressure
+    /// unknowns, monolithic above). The same discrete problem either way.
+    pub coupling: Coupling,
 }
 
 /// Default isotropic artificial diffusion factor.
@@ -640,6 +663,7 @@ impl Default for ReynoldsDomain {
             stabilisation: Stabilisation::Supg,
             artificial_diffusion: DEFAULT_ARTIFICIAL_DIFFUSION,
             crosswind_diffusion: DEFAULT_CROSSWIND_DIFFUSION,
+            coupling: Coupling::Auto,
         }
     }
 }
@@ -661,6 +685,8 @@ pub const REYNOLDS_FIELDS: &[Field] = &[
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0")),
     f!("crosswind_diffusion", "crosswind diffusion factor delta_CD (eps_CD = delta_CD h_e |rho' H u|, across the streamlines only; removes the crosswind stripes; 0 = off)", "",
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0")),
+    f!("coupling", "how Newton couples film and solid: the elastic block condensed onto the contact face (dense LU, fast on small meshes) or one sparse monolithic matrix (MUMPS; fast on fine meshes); auto = condensed up to 4,000 pressure unknowns", "",
+        Kind::Choice(Coupling::NAMES), Presence::Default("\"auto\"")),
 ];
 
 // ---------------------------------------------------------------------------------------

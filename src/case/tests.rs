@@ -227,6 +227,7 @@ fn choice_names_match_serde() {
     check(CavitationModel::ALL, CavitationModel::NAMES);
     check(SymmetryMode::ALL, SymmetryMode::NAMES);
     check(Stabilisation::ALL, Stabilisation::NAMES);
+    check(Coupling::ALL, Coupling::NAMES);
     assert_eq!(LubricationModel::Dry.to_string(), "none");
 }
 

@@ -7,8 +7,7 @@
 //! the start; `EHL_DEBUG=1` prints residual norms per block, the step limiter's binding node
 //! and writes `debug_profile_z0.csv` after a failure; `EHL_START=zero` starts from P = 0,
 //! U = 0; `EHL_NO_ROW_SCALING=1` and `EHL_NO_LIMIT=1` switch off the row scaling and the
-//! film step limiter. `EHL_MONOLITHIC=1` solves the monolithic (U, P, H0) system instead of
-//! the condensed (P, H0) one; `EHL_PTC=1` (with `EHL_PTC_DT0`) tries pseudo-transient
+//! film step limiter. `EHL_PTC=1` (with `EHL_PTC_DT0`) tries pseudo-transient
 //! continuation before the load continuation; `EHL_SKIP_PLAIN=1` skips the plain Newton
 //! attempt. `EHL_P1ISO=1` (condensed path) uses linear pressure on the P2 sub-triangles;
 //! `EHL_SUPG_DELTA` scales the SUPG parameter tau (default 1).
@@ -35,6 +34,8 @@ pub struct EhlSolution {
     pub steps: Vec<String>,
     pub assembly_s: f64,
     pub solve_s: f64,
+    /// "condensed", "monolithic" or "rigid" (see [`EhlSolver::coupling`]).
+    pub coupling: &'static str,
 }
 
 /// Dimensionless lubricant laws of the scene.
@@ -172,30 +173,31 @@ pub struct EhlSolver<'a> {
 }
 
 impl<'a> EhlSolver<'a> {
-    /// Condenses the elastic block onto the contact face (unless `EHL_MONOLITHIC` is set).
-    /// Collective.
+    /// Condenses the elastic block onto the contact face, unless the scene's
+    /// `reynolds.coupling` (see [`monolithic`]) asks for the monolithic system. Collective.
     pub fn new(ctx: &Context, scene: &Scene, mesh: &'a Mesh, part: &'a Partition, dofs: &'a DofMap, layout: &'a Layout, half: bool) -> Result<Self, String> {
         set_newton_defaults().map_err(|e| e.to_string())?;
-        let monolithic = std::env::var_os("EHL_MONOLITHIC").is_some();
-        if !monolithic {
+        let rigid = scene.effects.elasticity == crate::case::ElasticityModel::Rigid;
+        let p_nodes = pressure_nodes(mesh, layout);
+        let monolithic = !rigid && monolithic(scene.reynolds.coupling, p_nodes.len())?;
+        if monolithic {
+            ctx.log(format!("coupling: monolithic (reynolds.coupling = \"{}\", {} pressure unknowns): U, P and H0 in one sparse matrix, a MUMPS LU at every Newton step", scene.reynolds.coupling, p_nodes.len()));
+            // The condensed path picks its solver by the Jacobian's type (see `solve_condensed`).
+            petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
+        } else {
             // The condensed Jacobian is dense: MUMPS's PORD ordering rejects it, AMD is fine.
             petsc::options::set_default("-mat_mumps_icntl_7", "0").map_err(|e| e.to_string())?;
             // The condensation's 3D Cholesky has its own prefix and keeps PORD.
             petsc::options::set_default("-elastic_mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
         }
-        if monolithic {
-            // The condensed path picks its solver by the Jacobian's type (see `solve_condensed`).
-            petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
-        }
         let t0 = std::time::Instant::now();
-        let rigid = scene.effects.elasticity == crate::case::ElasticityModel::Rigid;
-        let p_nodes = pressure_nodes(mesh, layout);
         let comp = if rigid {
             ctx.log(format!("rigid solids: no elastic unknowns, H = H0 + (X^2 + Z^2)/2; sparse Newton on {} pressure unknowns", p_nodes.len()));
             Some(crate::solid::condense::Compliance::rigid(mesh.contact_nodes.clone(), p_nodes))
         } else if monolithic {
             None
         } else {
+            ctx.log(format!("coupling: condensed (reynolds.coupling = \"{}\", {} pressure unknowns): the elastic block eliminated onto the contact face, a dense LU at every Newton step", scene.reynolds.coupling, p_nodes.len()));
             let eq = scene.equivalent_solid();
             let comp = crate::solid::condense::face_compliance(&ctx.world, mesh, eq.nu, assembly::traction_factor(eq.nu), &p_nodes).map_err(|e| e.to_string())?;
             ctx.log(format!(
@@ -212,12 +214,30 @@ impl<'a> EhlSolver<'a> {
         Ok(EhlSolver { mesh, part, dofs, layout, half, comp, condensation_s })
     }
 
+    /// "condensed", "monolithic" or "rigid": the coupling this solver uses.
+    pub fn coupling(&self) -> &'static str {
+        match &self.comp {
+            None => "monolithic",
+            Some(c) if c.is_rigid() => "rigid",
+            Some(_) => "condensed",
+        }
+    }
+
     /// Solves the scene's operating point. `start`: a converged state of a neighbouring
     /// operating point (monolithic layout, as in [`EhlSolution::x`]); when Newton fails
     /// from it, the solve starts over from the Hertz start. Collective.
     pub fn solve(&self, ctx: &Context, scene: &Scene, start: Option<&[f64]>) -> Result<EhlSolution, String> {
         match &self.comp {
-            None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half),
+            None => {
+                if let Some(prev) = start {
+                    match solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, Some(prev)) {
+                        Ok(s) => return Ok(s),
+                        Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
+                        Err(e) => ctx.log(format!("Newton from the previous operating point failed ({e}); starting over from the Hertz start")),
+                    }
+                }
+                solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, None)
+            }
             Some(comp) => {
                 if let Some(prev) = start {
                     match solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, Some(prev)) {
@@ -236,6 +256,19 @@ impl<'a> EhlSolver<'a> {
 #[allow(clippy::too_many_arguments)]
 pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
     EhlSolver::new(ctx, scene, mesh, part, dofs, layout, half)?.solve(ctx, scene, None)
+}
+
+/// Whether `coupling` with `n_p` pressure unknowns means the monolithic system. The
+/// experimental P1 pressures (`EHL_P1P`, `EHL_P1ISO`) exist on the condensed path only.
+fn monolithic(coupling: crate::case::Coupling, n_p: usize) -> Result<bool, String> {
+    use crate::case::Coupling as C;
+    let p1 = crate::reynolds::p1_pressure() || crate::reynolds::p1iso_pressure();
+    match coupling {
+        C::Monolithic if p1 => Err("reynolds.coupling = \"monolithic\" is not available with the experimental P1 pressures (EHL_P1P, EHL_P1ISO): use \"condensed\" or \"auto\"".into()),
+        C::Monolithic => Ok(true),
+        C::Condensed => Ok(false),
+        C::Auto => Ok(!p1 && n_p > crate::case::AUTO_MONOLITHIC_ABOVE),
+    }
 }
 
 /// The face nodes that carry a pressure unknown in the condensed system, in
@@ -332,7 +365,8 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
         }
     }
     x[layout.h0 as usize] = out.x[cl.h0()];
-    Ok(EhlSolution { x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s })
+    let coupling = if comp.is_rigid() { "rigid" } else { "condensed" };
+    Ok(EhlSolution { x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s, coupling })
 }
 
 /// A consistent start for rigid solids. The Hertz start is far from a rigid solution, and
@@ -403,42 +437,49 @@ fn rigid_start(ctx: &Context, system: &mut CondensedSystem, x0: &mut [f64], (lo,
     result
 }
 
-/// The monolithic path: U, P and H0 in one sparse system.
-fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
+/// The monolithic path: U, P and H0 in one sparse system, from the Hertz start or from a
+/// previous state `start` (same layout).
+#[allow(clippy::too_many_arguments)]
+fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool, start: Option<&[f64]>) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
     let k = assembly::assemble_stiffness(comm, mesh, part, dofs, ctx.rank, eq.nu).map_err(pe)?;
-    let u_dry = dry_start(comm, ctx, mesh, part, dofs, &k, eq.nu).map_err(pe)?;
-
-    // Initial iterate: dry displacement, Hertz pressure, H0 from Hamrock-Dowson's hc.
-    let mut x0 = vec![0.0; layout.total()];
-    for n in 0..mesh.nodes.len() {
-        for c in 0..3 {
-            let (d, g) = (dofs.node_dof[n][c], layout.u[n][c]);
-            if d >= 0 {
-                x0[g as usize] = u_dry[d as usize];
+    let (x0, label) = match start {
+        Some(prev) => (prev.to_vec(), "the previous operating point"),
+        None => {
+            let u_dry = dry_start(comm, ctx, mesh, part, dofs, &k, eq.nu).map_err(pe)?;
+            // Initial iterate: dry displacement, Hertz pressure, H0 from Hamrock-Dowson's hc.
+            let mut x0 = vec![0.0; layout.total()];
+            for n in 0..mesh.nodes.len() {
+                for c in 0..3 {
+                    let (d, g) = (dofs.node_dof[n][c], layout.u[n][c]);
+                    if d >= 0 {
+                        x0[g as usize] = u_dry[d as usize];
+                    }
+                }
+                let p = layout.p[n];
+                if p >= 0 {
+                    let c = mesh.nodes[n];
+                    x0[p as usize] = hertz_load::hertz_pressure(c[0], c[2]);
+                }
             }
+            if std::env::var("EHL_START").as_deref() == Ok("zero") {
+                for v in x0.iter_mut() {
+                    *v = 0.0;
+                }
+            }
+            x0[layout.h0 as usize] = start_h0(scene, mesh, &|n| layout.uy(&x0, n))?;
+            (x0, "the Hertz start")
         }
-        let p = layout.p[n];
-        if p >= 0 {
-            let c = mesh.nodes[n];
-            x0[p as usize] = hertz_load::hertz_pressure(c[0], c[2]);
-        }
-    }
-    if std::env::var("EHL_START").as_deref() == Ok("zero") {
-        for v in x0.iter_mut() {
-            *v = 0.0;
-        }
-    }
-    x0[layout.h0 as usize] = start_h0(scene, mesh, &|n| layout.uy(&x0, n))?;
+    };
     let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank);
     let j = Matrix::new_aij(comm, layout.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?;
     let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene), k).map_err(pe)?;
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
-    ctx.log(format!("Newton from the Hertz start: {} unknowns ({} U, {} P, 1 H0)", layout.total(), layout.counts().0, layout.counts().1));
+    ctx.log(format!("Newton from {label}: {} unknowns ({} U, {} P, 1 H0), sparse Jacobian", layout.total(), layout.counts().0, layout.counts().1));
     if std::env::var_os("EHL_CHECK_JACOBIAN").is_some() {
         if std::env::var_os("EHL_NO_ROW_SCALING").is_none() {
             system.scale_rows(&x0).map_err(pe)?;
@@ -448,9 +489,9 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
         }
     }
     let (lo, hi) = (layout.ranges[ctx.rank], layout.ranges[ctx.rank + 1]);
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, "the Hertz start", true, &j, (lo, hi), layout.local(ctx.rank))?;
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.is_none(), &j, (lo, hi), layout.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
-    Ok(EhlSolution { x: out.x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s })
+    Ok(EhlSolution { x: out.x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s, coupling: "monolithic" })
 }
 
 /// Outcome of [`newton_with_continuation`].
@@ -916,5 +957,14 @@ mod tests {
         assert!(Collapse { at: [0.6, -0.5], pole: Some(-0.871) }.at_pole().is_none());
         assert!(Collapse { at: [0.0, -0.95], pole: Some(-1.2) }.at_pole().is_none());
         assert!(Collapse { at: [0.0, -0.9], pole: None }.at_pole().is_none());
+    }
+
+    #[test]
+    fn auto_coupling_switches_to_monolithic_above_the_measured_crossover() {
+        use crate::case::{Coupling, AUTO_MONOLITHIC_ABOVE as N};
+        assert!(!super::monolithic(Coupling::Auto, N).unwrap());
+        assert!(super::monolithic(Coupling::Auto, N + 1).unwrap());
+        assert!(!super::monolithic(Coupling::Condensed, 100 * N).unwrap());
+        assert!(super::monolithic(Coupling::Monolithic, 10).unwrap());
     }
 }
