@@ -32,6 +32,12 @@ struct Cli {
     /// --set operating.load=2000 (repeatable; the value is TOML, bare words are strings)
     #[arg(long = "set", value_name = "KEY=VALUE", action = ArgAction::Append)]
     set: Vec<String>,
+    /// Start Newton from the converged pressure of an earlier run (its output folder:
+    /// summary.json and face_pressure.csv), interpolated onto this mesh: mesh sequencing,
+    /// e.g. a refined mesh from the coarse solution. Falls back to the Hertz start if
+    /// Newton fails from it
+    #[arg(long, value_name = "DIR")]
+    start_from: Option<PathBuf>,
     /// Validate the scene file and exit without solving
     #[arg(long)]
     check: bool,
@@ -52,6 +58,10 @@ struct Cli {
     /// core ladder, 0.125 for the ring ladder); each level halves it
     #[arg(long, value_name = "H")]
     first_size: Option<f64>,
+    /// With --convergence-study: each level starts from the last converged level's
+    /// pressure (mesh sequencing, as --start-from) instead of the Hertz start
+    #[arg(long)]
+    sequence: bool,
     /// Print the scene-file reference (every key, unit, range, default) as Markdown and exit
     #[arg(long)]
     scene_reference: bool,
@@ -91,6 +101,8 @@ fn main() {
         ladder: cli.ladder,
         first_size: cli.first_size,
         overrides: cli.set,
+        start_from: cli.start_from,
+        study_sequence: cli.sequence,
     };
     let code = ehl_petsc::app::run(world, opts);
     drop(universe);

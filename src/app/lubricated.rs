@@ -116,7 +116,7 @@ pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
     })
 }
 
-pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
+pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<(), String> {
     let hertz = scene.hertz();
     ctx.log(format!("Hertz: a = {:.5e} m, p_H = {:.5e} Pa; lambda_bar = {:.4e}", hertz.a, hertz.ph, driver::lambda_bar(scene)));
     if let Some(zc) = scene.spin_pole_over_a() {
@@ -131,7 +131,11 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     if scene.is_sweep() {
         return super::sweep::run(ctx, scene, &setup, &solver);
     }
-    let sol = solver.solve(ctx, scene, None)?;
+    let sol = match earlier {
+        None => solver.solve(ctx, scene, None)?,
+        // Mesh sequencing: the earlier run's pressure, in this scene's scales.
+        Some(e) => e.solve(ctx, scene, &solver)?,
+    };
     let r = post_point(ctx, scene, &setup, &sol, solver.condensation_s, &ctx.out_dir);
     collective::agree(&ctx.world, r).map(|_| ())
 }
@@ -235,6 +239,9 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
     if scene.output.vtu {
         write_face_vtu(dir, &fields, a, ph, hs, friction.as_ref())?;
     }
+    // The nodal pressure a later run can start from (--start-from).
+    let face_p = dir.join(super::restart::FACE_PRESSURE);
+    crate::output::write_atomic(&face_p, super::restart::face_pressure_csv(mesh, &|n| fields.p_node(n), a, ph).as_bytes()).map_err(|e| format!("cannot write {}: {e}", face_p.display()))?;
     let hd = scene.hamrock_dowson();
     let (n_u, n_p) = layout.counts();
     let kin = scene.kinematics().expect("lubricated scene");

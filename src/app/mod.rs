@@ -4,6 +4,7 @@ pub mod collective;
 pub mod dry;
 pub mod lubricated;
 pub mod plots;
+pub mod restart;
 pub mod study;
 pub mod sweep;
 
@@ -30,6 +31,10 @@ pub struct RunOptions {
     pub first_size: Option<f64>,
     /// `--set KEY=VALUE` scene overrides, applied before validation.
     pub overrides: Vec<String>,
+    /// `--sequence`: each convergence-study level starts from the previous level's pressure.
+    pub study_sequence: bool,
+    /// `--start-from DIR`: Newton starts from the converged pressure of an earlier run.
+    pub start_from: Option<PathBuf>,
 }
 
 /// Shared state of one run on one rank.
@@ -100,6 +105,37 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             return 2;
         }
     }
+    if opts.study_sequence && opts.study_levels.is_none() {
+        if rank == 0 {
+            eprintln!("ehl-petsc: error: --sequence applies to --convergence-study N (a single solve takes --start-from DIR)");
+        }
+        return 2;
+    }
+    // --start-from: the earlier run is read and checked with the scene (exit 2, nothing
+    // written). Every rank reads it: the outcome is the same everywhere.
+    let earlier = match &opts.start_from {
+        None => None,
+        Some(dir) => {
+            let checked = if opts.study_levels.is_some() {
+                Err("--start-from applies to one solve, not to a --convergence-study".to_string())
+            } else if scene.is_sweep() {
+                Err("--start-from applies to one operating point: the scene has a [sweep] (each sweep point already starts from the previous one)".to_string())
+            } else if scene.effects.lubrication != crate::case::LubricationModel::Reynolds {
+                Err("--start-from needs a lubricated scene (effects.lubrication = \"reynolds\")".to_string())
+            } else {
+                restart::EarlierRun::read(dir)
+            };
+            match checked {
+                Ok(e) => Some(e),
+                Err(e) => {
+                    if rank == 0 {
+                        eprintln!("ehl-petsc: error: {e}");
+                    }
+                    return 2;
+                }
+            }
+        }
+    };
     if opts.check_only {
         if rank == 0 {
             println!("ehl-petsc: scene '{}' is valid", opts.scene.display());
@@ -128,9 +164,9 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {
-        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => study::run(&ctx, &scene, n, opts.ladder, first_size),
+        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => study::run(&ctx, &scene, n, opts.ladder, first_size, opts.study_sequence),
         Some(_) => Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into()),
-        None => simulate(&ctx, &scene),
+        None => simulate(&ctx, &scene, earlier.as_ref()),
     };
     let failed_here = result.is_err();
     let code = match collective::agree(&ctx.world, result) {
@@ -153,12 +189,12 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
 }
 
 /// Dispatches on what the scene asks to simulate.
-fn simulate(ctx: &Context, scene: &Scene) -> Result<(), String> {
+fn simulate(ctx: &Context, scene: &Scene, earlier: Option<&restart::EarlierRun>) -> Result<(), String> {
     for w in scene.warnings() {
         ctx.log(format!("warning: {w}"));
     }
     match scene.effects.lubrication {
         crate::case::LubricationModel::Dry => dry::run(ctx, scene),
-        crate::case::LubricationModel::Reynolds => lubricated::run(ctx, scene),
+        crate::case::LubricationModel::Reynolds => lubricated::run(ctx, scene, earlier),
     }
 }

@@ -172,11 +172,14 @@ struct Level {
 
 /// Solves `scene` on `levels` levels of `ladder` from size `first`; the caller has checked
 /// the ladder with [`check_ladder`] (app::run does, before any output is written).
-pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f64) -> Result<(), String> {
+/// With `sequence`, each level after the first starts from the last converged level's
+/// pressure (mesh sequencing, see [`super::restart`]).
+pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f64, sequence: bool) -> Result<(), String> {
     if scene.is_sweep() {
         return Err("--convergence-study solves one operating point: remove [sweep] from the scene".into());
     }
     let mut rows: Vec<Level> = Vec::new();
+    let mut last_converged: Option<std::path::PathBuf> = None;
     for k in 0..levels {
         let h = level_size(first, k);
         let sc = level_scene(scene, ladder, h);
@@ -187,7 +190,15 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
         let setup = Setup::new(ctx, &sc)?;
         let solver = EhlSolver::new(ctx, &sc, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
         let (n_u, n_p) = setup.layout.counts();
-        let solved = solver.solve(ctx, &sc, None).and_then(|sol| collective::agree(&ctx.world, post_point(ctx, &sc, &setup, &sol, solver.condensation_s, &dir)).map(|r| (sol, r)));
+        let earlier = match (&last_converged, sequence) {
+            (Some(d), true) => Some(super::restart::EarlierRun::read(d)?),
+            _ => None,
+        };
+        let solved = match &earlier {
+            Some(e) => e.solve(ctx, &sc, &solver),
+            None => solver.solve(ctx, &sc, None),
+        }
+        .and_then(|sol| collective::agree(&ctx.world, post_point(ctx, &sc, &setup, &sol, solver.condensation_s, &dir)).map(|r| (sol, r)));
         let rss_mb = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
         let level = match solved {
             Ok((sol, r)) => Level { failed: None, h, n_u, n_p, its: sol.newton_total, mesh_s: setup.mesh_s, setup_s: solver.condensation_s.unwrap_or(sol.assembly_s), coupling: solver.coupling(), newton_s: sol.solve_s, total_s: t0.elapsed().as_secs_f64(), rss_mb, r },
@@ -204,6 +215,9 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
                 Level { failed: Some(e), h, n_u, n_p, its: 0, mesh_s: setup.mesh_s, setup_s: solver.condensation_s.unwrap_or(0.0), coupling: solver.coupling(), newton_s: 0.0, total_s: t0.elapsed().as_secs_f64(), rss_mb, r: PointResult::default() }
             }
         };
+        if level.failed.is_none() {
+            last_converged = Some(dir.clone());
+        }
         rows.push(level);
     }
     let ok = rows.iter().filter(|r| r.failed.is_none()).count();
@@ -211,12 +225,12 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
         return Err(format!("convergence study: only {ok} of {levels} levels converged; nothing to compare"));
     }
     if ctx.rank == 0 {
-        write_outputs(ctx, scene, &rows)?;
+        write_outputs(ctx, scene, &rows, sequence)?;
     }
     Ok(())
 }
 
-fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level]) -> Result<(), String> {
+fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) -> Result<(), String> {
     // Failed levels are listed, then left out of the estimates (the ladder still halves h
     // between the converged levels, which follow each other).
     let failed: Vec<String> = all.iter().enumerate().filter_map(|(k, r)| r.failed.as_ref().map(|e| format!("level {} (h = {} a): {e}", k + 1, r.h))).collect();
@@ -265,6 +279,9 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level]) -> Result<(), Stri
     }
     for f in &failed {
         md.push_str(&format!("\nFailed: {f}\n"));
+    }
+    if sequence {
+        md.push_str("\nLevels after the first started from the last converged level's pressure (--sequence): their Newton iterations and times are those of a refinement step, not of a solve from the Hertz start.\n");
     }
     md.push_str("\nReference values:\n\n");
     for (qi, (name, _)) in quantities.iter().enumerate() {

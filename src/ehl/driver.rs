@@ -38,6 +38,30 @@ pub struct EhlSolution {
     pub coupling: &'static str,
 }
 
+/// Where Newton starts.
+#[derive(Clone, Copy)]
+pub enum Start<'s> {
+    /// The dry Hertz pressure and its deflection, H0 from Hamrock-Dowson's central film.
+    Hertz,
+    /// A converged state of a neighbouring operating point on the same mesh (monolithic
+    /// layout, as in [`EhlSolution::x`]).
+    Previous(&'s [f64]),
+    /// A pressure field P(X, Z) from another mesh (mesh sequencing: a coarser level's
+    /// converged solution, interpolated), its deflection, and H0 so that the central film
+    /// is `hc` (dimensionless). `label` names it in the log.
+    Pressure { p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str },
+}
+
+impl Start<'_> {
+    fn label(&self) -> &str {
+        match self {
+            Start::Hertz => "the Hertz start",
+            Start::Previous(_) => "the previous operating point",
+            Start::Pressure { label, .. } => label,
+        }
+    }
+}
+
 /// Dimensionless lubricant laws of the scene.
 pub fn lubricant(scene: &Scene) -> Lubricant {
     let ph = scene.hertz().ph;
@@ -67,12 +91,14 @@ pub fn lambda_bar(scene: &Scene) -> f64 {
     12.0 * eta_r * ue * r * r / (h.a.powi(3) * h.ph)
 }
 
-/// Solves the displacement under the Hertz pressure interpolated at the P2 nodes (the
-/// discrete pressure of the start, so the start satisfies the elastic rows exactly and
-/// equals the condensed path's start): the starting state of Newton.
-fn dry_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &Partition, dofs: &DofMap, k: &Matrix, nu: f64) -> petsc::Result<Vec<f64>> {
+/// Solves the displacement under the pressure `p(X, Z)` (the Hertz pressure, or a coarser
+/// level's) interpolated at the P2 nodes (the discrete pressure of the start, so the start
+/// satisfies the elastic rows exactly and equals the condensed path's start): the starting
+/// state of Newton.
+#[allow(clippy::too_many_arguments)]
+fn elastic_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &Partition, dofs: &DofMap, k: &Matrix, nu: f64, p: &dyn Fn(f64, f64) -> f64) -> petsc::Result<Vec<f64>> {
     let nodal = |v: &[[f64; 2]; 3]| -> [f64; 6] {
-        let p = crate::fem::p2tri::p2_tri_node_coords(v).map(|q| hertz_load::hertz_pressure(q[0], q[1]));
+        let p = crate::fem::p2tri::p2_tri_node_coords(v).map(|q| p(q[0], q[1]));
         let m = super::system::p2_tri_mass(super::system::tri_area(v));
         std::array::from_fn(|i| (0..6).map(|j| m[i][j] * p[j]).sum())
     };
@@ -143,11 +169,11 @@ fn hc_guess(scene: &Scene) -> f64 {
     (scene.hamrock_dowson().map(|hd| hd.central_film_thickness()).unwrap_or(0.0) / scene.scales().film_scale()).max(0.02)
 }
 
-/// H0 of the start: the estimated central film over the dry deflection at the centre,
-/// raised if needed so that the starting film is positive everywhere (a coarse mesh's dry
-/// deflection is not flat in the contact). `uy` gives U_y at a contact node.
-fn start_h0(scene: &Scene, mesh: &Mesh, uy: &dyn Fn(u32) -> f64) -> Result<f64, String> {
-    let hc = hc_guess(scene);
+/// H0 of the start: the central film `hc` (estimated, or a coarser level's) over the
+/// starting deflection at the centre, raised if needed so that the starting film is
+/// positive everywhere (a coarse mesh's dry deflection is not flat in the contact). `uy`
+/// gives U_y at a contact node.
+fn start_h0(hc: f64, mesh: &Mesh, uy: &dyn Fn(u32) -> f64) -> Result<f64, String> {
     let centre = mesh.locate_contact(0.0, 0.0).ok_or("contact centre not on the contact face")?;
     let uy_centre = crate::fem::p2_tri_eval(&mesh.contact_tris[centre.0].map(uy), centre.1);
     let min_gap = mesh.contact_nodes.iter().map(|&n| Layout::gap(mesh.nodes[n as usize]) - uy(n)).fold(f64::INFINITY, f64::min);
@@ -227,28 +253,25 @@ impl<'a> EhlSolver<'a> {
     /// operating point (monolithic layout, as in [`EhlSolution::x`]); when Newton fails
     /// from it, the solve starts over from the Hertz start. Collective.
     pub fn solve(&self, ctx: &Context, scene: &Scene, start: Option<&[f64]>) -> Result<EhlSolution, String> {
-        match &self.comp {
-            None => {
-                if let Some(prev) = start {
-                    match solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, Some(prev)) {
-                        Ok(s) => return Ok(s),
-                        Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
-                        Err(e) => ctx.log(format!("Newton from the previous operating point failed ({e}); starting over from the Hertz start")),
-                    }
-                }
-                solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, None)
-            }
-            Some(comp) => {
-                if let Some(prev) = start {
-                    match solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, Some(prev)) {
-                        Ok(s) => return Ok(s),
-                        Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
-                        Err(e) => ctx.log(format!("Newton from the previous operating point failed ({e}); starting over from the Hertz start")),
-                    }
-                }
-                solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, None)
+        self.solve_from(ctx, scene, start.map_or(Start::Hertz, Start::Previous))
+    }
+
+    /// Solves the scene's operating point from `start`; when Newton fails from a start
+    /// other than the Hertz start, the solve starts over from the Hertz start (with its
+    /// automatic continuation). Collective.
+    pub fn solve_from(&self, ctx: &Context, scene: &Scene, start: Start) -> Result<EhlSolution, String> {
+        let once = |start: Start| match &self.comp {
+            None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start),
+            Some(comp) => solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, start),
+        };
+        if !matches!(start, Start::Hertz) {
+            match once(start) {
+                Ok(s) => return Ok(s),
+                Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
+                Err(e) => ctx.log(format!("Newton from {} failed ({e}); starting over from the Hertz start", start.label())),
             }
         }
+        once(Start::Hertz)
     }
 }
 
@@ -290,7 +313,7 @@ pub const CONDENSED_PREFIX: &std::ffi::CStr = c"condensed_";
 
 /// The condensed path: Newton on (P, H0) with the face compliance `comp`, from the Hertz
 /// start or from a previous state `start` (monolithic layout).
-fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, comp: &crate::solid::condense::Compliance, half: bool, start: Option<&[f64]>) -> Result<EhlSolution, String> {
+fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, comp: &crate::solid::condense::Compliance, half: bool, start: Start) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
@@ -299,27 +322,32 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     let cl = system.layout.clone();
     system.debug_mesh = Some(mesh);
     let mut x0 = vec![0.0; cl.total()];
+    let hertz = |x: f64, z: f64| hertz_load::hertz_pressure(x, z);
     let label = match start {
-        Some(prev) => {
+        Start::Previous(prev) => {
             for (j, &n) in comp.cols.iter().enumerate() {
                 x0[j] = prev[layout.p[n as usize] as usize];
             }
             x0[cl.h0()] = prev[layout.h0 as usize];
-            "the previous operating point"
+            start.label()
         }
-        None => {
-            // Hertz pressure and its (condensed) deflection.
+        Start::Hertz | Start::Pressure { .. } => {
+            // The pressure and its (condensed) deflection.
+            let (p, hc): (&dyn Fn(f64, f64) -> f64, f64) = match start {
+                Start::Pressure { p, hc, .. } => (p, hc),
+                _ => (&hertz, hc_guess(scene)),
+            };
             for (j, &n) in comp.cols.iter().enumerate() {
                 let c = mesh.nodes[n as usize];
-                x0[j] = hertz_load::hertz_pressure(c[0], c[2]);
+                x0[j] = p(c[0], c[2]);
             }
             let uy0 = system.uy(&x0);
-            x0[cl.h0()] = start_h0(scene, mesh, &|n| uy0[cl.face_index[n as usize] as usize])?;
-            if comp.is_rigid() {
+            x0[cl.h0()] = start_h0(hc, mesh, &|n| uy0[cl.face_index[n as usize] as usize])?;
+            if comp.is_rigid() && matches!(start, Start::Hertz) {
                 rigid_start(ctx, &mut system, &mut x0, (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]), cl.local(ctx.rank))?;
                 "the rigid start"
             } else {
-                "the Hertz start"
+                start.label()
             }
         }
     };
@@ -337,7 +365,7 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     let t1 = std::time::Instant::now();
     let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);
     ctx.log(format!("Newton from {label}: {} unknowns ({} P, 1 H0), {} Jacobian", cl.total(), cl.n_p, if comp.is_rigid() { "sparse" } else { "dense" }));
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.is_none(), &j, (lo, hi), cl.local(ctx.rank))?;
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, matches!(start, Start::Hertz), &j, (lo, hi), cl.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
     let uy = system.uy(&out.x);
@@ -440,17 +468,22 @@ fn rigid_start(ctx: &Context, system: &mut CondensedSystem, x0: &mut [f64], (lo,
 /// The monolithic path: U, P and H0 in one sparse system, from the Hertz start or from a
 /// previous state `start` (same layout).
 #[allow(clippy::too_many_arguments)]
-fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool, start: Option<&[f64]>) -> Result<EhlSolution, String> {
+fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool, start: Start) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
     let k = assembly::assemble_stiffness(comm, mesh, part, dofs, ctx.rank, eq.nu).map_err(pe)?;
-    let (x0, label) = match start {
-        Some(prev) => (prev.to_vec(), "the previous operating point"),
-        None => {
-            let u_dry = dry_start(comm, ctx, mesh, part, dofs, &k, eq.nu).map_err(pe)?;
-            // Initial iterate: dry displacement, Hertz pressure, H0 from Hamrock-Dowson's hc.
+    let hertz = |x: f64, z: f64| hertz_load::hertz_pressure(x, z);
+    let (p, hc): (&dyn Fn(f64, f64) -> f64, f64) = match start {
+        Start::Pressure { p, hc, .. } => (p, hc),
+        _ => (&hertz, hc_guess(scene)),
+    };
+    let x0 = match start {
+        Start::Previous(prev) => prev.to_vec(),
+        Start::Hertz | Start::Pressure { .. } => {
+            let u_dry = elastic_start(comm, ctx, mesh, part, dofs, &k, eq.nu, p).map_err(pe)?;
+            // Initial iterate: the start pressure, its displacement, H0 from the central film.
             let mut x0 = vec![0.0; layout.total()];
             for n in 0..mesh.nodes.len() {
                 for c in 0..3 {
@@ -459,10 +492,10 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
                         x0[g as usize] = u_dry[d as usize];
                     }
                 }
-                let p = layout.p[n];
-                if p >= 0 {
+                let d = layout.p[n];
+                if d >= 0 {
                     let c = mesh.nodes[n];
-                    x0[p as usize] = hertz_load::hertz_pressure(c[0], c[2]);
+                    x0[d as usize] = p(c[0], c[2]);
                 }
             }
             if std::env::var("EHL_START").as_deref() == Ok("zero") {
@@ -470,10 +503,11 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
                     *v = 0.0;
                 }
             }
-            x0[layout.h0 as usize] = start_h0(scene, mesh, &|n| layout.uy(&x0, n))?;
-            (x0, "the Hertz start")
+            x0[layout.h0 as usize] = start_h0(hc, mesh, &|n| layout.uy(&x0, n))?;
+            x0
         }
     };
+    let label = start.label();
     let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank);
     let j = Matrix::new_aij(comm, layout.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?;
     let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene), k).map_err(pe)?;
@@ -489,7 +523,7 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
         }
     }
     let (lo, hi) = (layout.ranges[ctx.rank], layout.ranges[ctx.rank + 1]);
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.is_none(), &j, (lo, hi), layout.local(ctx.rank))?;
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, matches!(start, Start::Hertz), &j, (lo, hi), layout.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     Ok(EhlSolution { x: out.x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s, coupling: "monolithic" })
 }
