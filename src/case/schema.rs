@@ -591,7 +591,8 @@ choice_enum! {
 choice_enum! {
     /// `reynolds.coupling`: how Newton's linear systems couple the film to the solid.
     pub enum Coupling {
-        /// "condensed" up to [`AUTO_MONOLITHIC_ABOVE`] pressure unknowns, "monolithic" above.
+        /// "condensed" up to [`AUTO_MONOLITHIC_ABOVE`] pressure unknowns (a sweep: up to
+        /// [`AUTO_MONOLITHIC_ABOVE_SWEEP`]), "monolithic" above.
         Auto = "auto",
         /// The elastic block eliminated once onto the contact face (a dense face
         /// compliance); Newton on (P, H0) with a dense LU: fastest on small meshes, but
@@ -604,9 +605,15 @@ choice_enum! {
 
 /// `reynolds.coupling = "auto"` solves the monolithic system above this many pressure
 /// unknowns. Measured on table2-ue2 (2 ranks, README "Coupling"): at 3,220 pressure
-/// unknowns the condensed solve takes 13.7 s and the monolithic 16.9 s, at 4,824 they take
-/// 32 s and 25 s, at 11,040 681 s and 83 s.
+/// unknowns the condensed solve takes 14.0 s and the monolithic 17.8 s, at 4,824 they take
+/// 35.7 s and 29.2 s, at 11,040 337 s and 96.5 s.
 pub const AUTO_MONOLITHIC_ABOVE: usize = 4000;
+
+/// The same for a sweep, which condenses once for all its points, so only the cost of a
+/// Newton step counts: on case2's mesh (6,353 pressure unknowns, 2 ranks) a condensed step
+/// (dense LU) takes about 3.3 s and a monolithic one (sparse LU of 123,828 unknowns) about
+/// 5.8 s; the dense LU grows as n^3, so the two meet near 8,000.
+pub const AUTO_MONOLITHIC_ABOVE_SWEEP: usize = 8000;
 
 /// Default dimensionless cavitation penalty factor xi.
 pub const DEFAULT_PENALTY: f64 = 1e4;
@@ -643,7 +650,7 @@ pub struct ReynoldsDomain {
     /// contact (hm -9.5 % at 2 GPa), so the default is 0 (README "Crosswind diffusion").
     pub crosswind_diffusion: f64,
     /// "auto" | "condensed" | "monolithic"; default "auto" (condensed up to 4,000 pressure
-    /// unknowns, monolithic above). The same discrete problem either way.
+    /// unknowns, 8,000 in a sweep, monolithic above). The same discrete problem either way.
     pub coupling: Coupling,
 }
 
@@ -685,7 +692,7 @@ pub const REYNOLDS_FIELDS: &[Field] = &[
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0")),
     f!("crosswind_diffusion", "crosswind diffusion factor delta_CD (eps_CD = delta_CD h_e |rho' H u|, across the streamlines only; removes the crosswind stripes; 0 = off)", "",
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0")),
-    f!("coupling", "how Newton couples film and solid: the elastic block condensed onto the contact face (dense LU, fast on small meshes) or one sparse monolithic matrix (MUMPS; fast on fine meshes); auto = condensed up to 4,000 pressure unknowns", "",
+    f!("coupling", "how Newton couples film and solid: the elastic block condensed onto the contact face (dense LU, fast on small meshes) or one sparse monolithic matrix (MUMPS; fast on fine meshes); auto = condensed up to 4,000 pressure unknowns (a sweep: 8,000)", "",
         Kind::Choice(Coupling::NAMES), Presence::Default("\"auto\"")),
 ];
 

@@ -205,7 +205,7 @@ impl<'a> EhlSolver<'a> {
         set_newton_defaults().map_err(|e| e.to_string())?;
         let rigid = scene.effects.elasticity == crate::case::ElasticityModel::Rigid;
         let p_nodes = pressure_nodes(mesh, layout);
-        let monolithic = !rigid && monolithic(scene.reynolds.coupling, p_nodes.len())?;
+        let monolithic = !rigid && monolithic(scene.reynolds.coupling, p_nodes.len(), scene.is_sweep())?;
         if monolithic {
             ctx.log(format!("coupling: monolithic (reynolds.coupling = \"{}\", {} pressure unknowns): U, P and H0 in one sparse matrix, a MUMPS LU at every Newton step", scene.reynolds.coupling, p_nodes.len()));
             // The condensed path picks its solver by the Jacobian's type (see `solve_condensed`).
@@ -281,16 +281,17 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
     EhlSolver::new(ctx, scene, mesh, part, dofs, layout, half)?.solve(ctx, scene, None)
 }
 
-/// Whether `coupling` with `n_p` pressure unknowns means the monolithic system. The
-/// experimental P1 pressures (`EHL_P1P`, `EHL_P1ISO`) exist on the condensed path only.
-fn monolithic(coupling: crate::case::Coupling, n_p: usize) -> Result<bool, String> {
+/// Whether `coupling` with `n_p` pressure unknowns (in a `sweep` or not) means the
+/// monolithic system. The experimental P1 pressures (`EHL_P1P`, `EHL_P1ISO`) exist on the
+/// condensed path only.
+fn monolithic(coupling: crate::case::Coupling, n_p: usize, sweep: bool) -> Result<bool, String> {
     use crate::case::Coupling as C;
     let p1 = crate::reynolds::p1_pressure() || crate::reynolds::p1iso_pressure();
     match coupling {
         C::Monolithic if p1 => Err("reynolds.coupling = \"monolithic\" is not available with the experimental P1 pressures (EHL_P1P, EHL_P1ISO): use \"condensed\" or \"auto\"".into()),
         C::Monolithic => Ok(true),
         C::Condensed => Ok(false),
-        C::Auto => Ok(!p1 && n_p > crate::case::AUTO_MONOLITHIC_ABOVE),
+        C::Auto => Ok(!p1 && n_p > if sweep { crate::case::AUTO_MONOLITHIC_ABOVE_SWEEP } else { crate::case::AUTO_MONOLITHIC_ABOVE }),
     }
 }
 
@@ -995,10 +996,12 @@ mod tests {
 
     #[test]
     fn auto_coupling_switches_to_monolithic_above_the_measured_crossover() {
-        use crate::case::{Coupling, AUTO_MONOLITHIC_ABOVE as N};
-        assert!(!super::monolithic(Coupling::Auto, N).unwrap());
-        assert!(super::monolithic(Coupling::Auto, N + 1).unwrap());
-        assert!(!super::monolithic(Coupling::Condensed, 100 * N).unwrap());
-        assert!(super::monolithic(Coupling::Monolithic, 10).unwrap());
+        use crate::case::{Coupling, AUTO_MONOLITHIC_ABOVE as N, AUTO_MONOLITHIC_ABOVE_SWEEP as NS};
+        assert!(!super::monolithic(Coupling::Auto, N, false).unwrap());
+        assert!(super::monolithic(Coupling::Auto, N + 1, false).unwrap());
+        assert!(!super::monolithic(Coupling::Auto, N + 1, true).unwrap());
+        assert!(super::monolithic(Coupling::Auto, NS + 1, true).unwrap());
+        assert!(!super::monolithic(Coupling::Condensed, 100 * N, false).unwrap());
+        assert!(super::monolithic(Coupling::Monolithic, 10, true).unwrap());
     }
 }
