@@ -45,3 +45,32 @@ fn convergence_study_writes_its_table_and_plots() {
     assert_eq!(bad.status.code(), Some(2), "{}", text(&bad));
     assert!(text(&bad).contains("--first-size 0.1"), "{}", text(&bad));
 }
+
+/// A ring ladder whose second level crosses `reynolds.coupling = "auto"`'s switch (2,720
+/// then 4,824 pressure unknowns: condensed, then monolithic) in one process, each level
+/// from the previous one's pressure (`--sequence`). The condensed level's solver defaults
+/// (ScaLAPACK) must not leak into the monolithic level, and both films must match the
+/// runs of the same meshes from the Hertz start (README.md's narrow-ring ladder, 2 ranks).
+#[test]
+fn sequenced_ring_ladder_switches_coupling() {
+    let dir = scratch("study-sequence");
+    let scene = std::fs::read_to_string(repo().join("cases/paper/table2-ue2.toml")).unwrap();
+    let path = write_scene(&dir, "scene.toml", &scene);
+    let out_dir = dir.join("out");
+    let out = mpirun(2, &["--convergence-study", "2", "--ladder", "ring", "--first-size", "0.0625", "--sequence", path.as_str(), "--set", "mesh.ring_inner=0.92", "--set", "mesh.ring_outer=1.02", "--output", out_dir.to_str().unwrap()]);
+    let t = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{t}");
+    assert!(t.contains("coupling: condensed") && t.contains("coupling: monolithic"), "{t}");
+    assert!(t.contains("Newton from the pressure of"), "{t}");
+    let md = std::fs::read_to_string(out_dir.join("study.md")).unwrap();
+    assert!(md.contains("--sequence"), "{md}");
+    // hc, hm of the two meshes from the Hertz start (README "hm on a narrow ring ladder":
+    // 0.36427 / 0.13652 and 0.36301 / 0.13636 um): the same discrete problems, so they
+    // agree to the 5 printed digits.
+    for (level, hc, hm) in [(1, 0.36427e-6, 0.13652e-6), (2, 0.36301e-6, 0.13636e-6)] {
+        let s = summary(&out_dir.join(format!("level_{level}")));
+        let (h, m) = (num(&s, "film.hc_m"), num(&s, "film.hm_m"));
+        // Half a unit of the 5th printed digit (0.5e-5 um), plus round-off.
+        assert!((h - hc).abs() < 0.51e-11 && (m - hm).abs() < 0.51e-11, "level {level}: hc {h}, hm {m}");
+    }
+}

@@ -610,9 +610,10 @@ choice_enum! {
 pub const AUTO_MONOLITHIC_ABOVE: usize = 4000;
 
 /// The same for a sweep, which condenses once for all its points, so only the cost of a
-/// Newton step counts: on case2's mesh (6,353 pressure unknowns, 2 ranks) a condensed step
-/// (dense LU) takes about 3.3 s and a monolithic one (sparse LU of 123,828 unknowns) about
-/// 5.8 s; the dense LU grows as n^3, so the two meet near 8,000.
+/// Newton step counts: on case2's mesh (6,353 pressure unknowns, 2 ranks; `ci/bench`: 16
+/// iterations, 95.9 s with a 33 s condensation, 99.8 s with a 10 s assembly) a condensed
+/// step (dense LU) takes about 3.9 s and a monolithic one (sparse LU of 123,828 unknowns)
+/// about 5.6 s; the dense LU grows as n^3, so the two meet near 8,000.
 pub const AUTO_MONOLITHIC_ABOVE_SWEEP: usize = 8000;
 
 /// Default dimensionless cavitation penalty factor xi.

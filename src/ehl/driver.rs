@@ -208,11 +208,13 @@ impl<'a> EhlSolver<'a> {
         let monolithic = !rigid && monolithic(scene.reynolds.coupling, p_nodes.len(), scene.is_sweep())?;
         if monolithic {
             ctx.log(format!("coupling: monolithic (reynolds.coupling = \"{}\", {} pressure unknowns): U, P and H0 in one sparse matrix, a MUMPS LU at every Newton step", scene.reynolds.coupling, p_nodes.len()));
-            // The condensed path picks its solver by the Jacobian's type (see `solve_condensed`).
+            // The condensed path picks its solver by the Jacobian's type (see `solve_condensed`);
+            // a convergence study may have run it before in this process.
             petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
+            petsc::options::set_ours("-mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
         } else {
             // The condensed Jacobian is dense: MUMPS's PORD ordering rejects it, AMD is fine.
-            petsc::options::set_default("-mat_mumps_icntl_7", "0").map_err(|e| e.to_string())?;
+            petsc::options::set_ours("-mat_mumps_icntl_7", "0").map_err(|e| e.to_string())?;
             // The condensation's 3D Cholesky has its own prefix and keeps PORD.
             petsc::options::set_default("-elastic_mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
         }

@@ -10,7 +10,7 @@ use std::ffi::CStr;
 pub fn set_direct_solver_defaults(prefix: &str) -> Result<()> {
     options::set_default(&format!("-{prefix}ksp_type"), "preonly")?;
     options::set_default(&format!("-{prefix}pc_type"), "lu")?;
-    options::set_default(&format!("-{prefix}pc_factor_mat_solver_type"), "mumps")?;
+    options::set_ours(&format!("-{prefix}pc_factor_mat_solver_type"), "mumps")?;
     options::set_default("-mat_mumps_icntl_7", "4")?;
     Ok(())
 }
@@ -26,7 +26,7 @@ pub fn set_direct_solver_defaults_for(prefix: &str, a: &Matrix) -> Result<()> {
         "scalapack" => "scalapack",
         _ => "mumps",
     };
-    options::set_default(&format!("-{prefix}pc_factor_mat_solver_type"), solver)
+    options::set_ours(&format!("-{prefix}pc_factor_mat_solver_type"), solver)
 }
 
 /// A Krylov solver context (any KSP/PC through PETSc options).

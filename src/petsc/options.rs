@@ -15,13 +15,35 @@ pub fn has(name: &str) -> Result<bool> {
     Ok(set != 0)
 }
 
-/// Sets `name value` unless the user already gave `name`: our defaults stay overridable.
+/// The options our own code set (the rest of the database is the user's).
+static OURS: std::sync::Mutex<std::collections::BTreeSet<String>> = std::sync::Mutex::new(std::collections::BTreeSet::new());
+
+fn set_value(name: &str, value: &str) -> Result<()> {
+    let (n, v) = (cstr(name), cstr(value));
+    pcall!(super::ffi::PetscOptionsSetValue(std::ptr::null_mut(), n.as_ptr(), if value.is_empty() { std::ptr::null() } else { v.as_ptr() }))?;
+    OURS.lock().unwrap_or_else(|e| e.into_inner()).insert(name.to_string());
+    Ok(())
+}
+
+/// Sets `name value` unless `name` is already set (by the user, or by an earlier default):
+/// our defaults stay overridable.
 pub fn set_default(name: &str, value: &str) -> Result<()> {
     if has(name)? {
         return Ok(());
     }
-    let (n, v) = (cstr(name), cstr(value));
-    pcall!(super::ffi::PetscOptionsSetValue(std::ptr::null_mut(), n.as_ptr(), if value.is_empty() { std::ptr::null() } else { v.as_ptr() }))
+    set_value(name, value)
+}
+
+/// Sets `name value` unless the user gave `name`; a value our own code set earlier is
+/// replaced. For defaults that depend on what is being solved, when one process solves
+/// several systems (a convergence study switching from the condensed to the monolithic
+/// coupling needs MUMPS where the condensed path had set ScaLAPACK).
+pub fn set_ours(name: &str, value: &str) -> Result<()> {
+    let ours = OURS.lock().unwrap_or_else(|e| e.into_inner()).contains(name);
+    if has(name)? && !ours {
+        return Ok(());
+    }
+    set_value(name, value)
 }
 
 /// Reads an option's value as a string, if set.
