@@ -85,55 +85,15 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     let rank = world.rank() as usize;
     let size = world.size() as usize;
     let start = Instant::now();
-    // The scene is read and validated on every rank: the outcome is the same everywhere.
-    let scene = match crate::case::load_scene_with(&opts.scene, &opts.overrides) {
-        Ok(s) => s,
+    // The scene, the ladder and the earlier run are read and checked on every rank: the
+    // outcome is the same everywhere (exit 2, nothing written).
+    let (scene, first_size, earlier) = match checked_inputs(&opts) {
+        Ok(v) => v,
         Err(e) => {
             if rank == 0 {
                 eprintln!("ehl-petsc: error: {e}");
             }
             return 2;
-        }
-    };
-    // A convergence study's ladder is checked with the scene (exit 2, nothing written).
-    let first_size = opts.first_size.unwrap_or(opts.ladder.default_first());
-    if let Some(n) = opts.study_levels {
-        if let Err(e) = study::check_ladder(opts.ladder, first_size, n) {
-            if rank == 0 {
-                eprintln!("ehl-petsc: error: {e}");
-            }
-            return 2;
-        }
-    }
-    if opts.study_sequence && opts.study_levels.is_none() {
-        if rank == 0 {
-            eprintln!("ehl-petsc: error: --sequence applies to --convergence-study N (a single solve takes --start-from DIR)");
-        }
-        return 2;
-    }
-    // --start-from: the earlier run is read and checked with the scene (exit 2, nothing
-    // written). Every rank reads it: the outcome is the same everywhere.
-    let earlier = match &opts.start_from {
-        None => None,
-        Some(dir) => {
-            let checked = if opts.study_levels.is_some() {
-                Err("--start-from applies to one solve, not to a --convergence-study".to_string())
-            } else if scene.is_sweep() {
-                Err("--start-from applies to one operating point: the scene has a [sweep] (each sweep point already starts from the previous one)".to_string())
-            } else if scene.effects.lubrication != crate::case::LubricationModel::Reynolds {
-                Err("--start-from needs a lubricated scene (effects.lubrication = \"reynolds\")".to_string())
-            } else {
-                restart::EarlierRun::read(dir)
-            };
-            match checked {
-                Ok(e) => Some(e),
-                Err(e) => {
-                    if rank == 0 {
-                        eprintln!("ehl-petsc: error: {e}");
-                    }
-                    return 2;
-                }
-            }
         }
     };
     if opts.check_only {
@@ -186,6 +146,28 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     };
     drop(petsc);
     code
+}
+
+/// What `run` checks before it touches the output folder: the scene (with its `--set`
+/// overrides), a convergence study's ladder (its first size returned), and the earlier run
+/// of `--start-from`.
+fn checked_inputs(opts: &RunOptions) -> Result<(Scene, f64, Option<restart::EarlierRun>), String> {
+    let scene = crate::case::load_scene_with(&opts.scene, &opts.overrides).map_err(|e| e.to_string())?;
+    let first_size = opts.first_size.unwrap_or(opts.ladder.default_first());
+    if let Some(n) = opts.study_levels {
+        study::check_ladder(opts.ladder, first_size, n)?;
+    }
+    if opts.study_sequence && opts.study_levels.is_none() {
+        return Err("--sequence applies to --convergence-study N (a single solve takes --start-from DIR)".into());
+    }
+    let earlier = match &opts.start_from {
+        None => None,
+        Some(_) if opts.study_levels.is_some() => return Err("--start-from applies to one solve, not to a --convergence-study".into()),
+        Some(_) if scene.is_sweep() => return Err("--start-from applies to one operating point: the scene has a [sweep] (each sweep point already starts from the previous one)".into()),
+        Some(_) if scene.effects.lubrication != crate::case::LubricationModel::Reynolds => return Err("--start-from needs a lubricated scene (effects.lubrication = \"reynolds\")".into()),
+        Some(dir) => Some(restart::EarlierRun::read(dir)?),
+    };
+    Ok((scene, first_size, earlier))
 }
 
 /// Dispatches on what the scene asks to simulate.

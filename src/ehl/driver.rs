@@ -52,7 +52,16 @@ pub enum Start<'s> {
     Pressure { p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str },
 }
 
-impl Start<'_> {
+impl<'s> Start<'s> {
+    /// The starting pressure P(X, Z) and central film of a start that is not a previous
+    /// state: the Hertz pressure with Hamrock-Dowson's hc, or the given field.
+    fn pressure(&self, scene: &Scene) -> (&'s dyn Fn(f64, f64) -> f64, f64) {
+        match *self {
+            Start::Pressure { p, hc, .. } => (p, hc),
+            _ => (&hertz_load::hertz_pressure, hc_guess(scene)),
+        }
+    }
+
     fn label(&self) -> &str {
         match self {
             Start::Hertz => "the Hertz start",
@@ -325,7 +334,6 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     let cl = system.layout.clone();
     system.debug_mesh = Some(mesh);
     let mut x0 = vec![0.0; cl.total()];
-    let hertz = |x: f64, z: f64| hertz_load::hertz_pressure(x, z);
     let label = match start {
         Start::Previous(prev) => {
             for (j, &n) in comp.cols.iter().enumerate() {
@@ -336,10 +344,7 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
         }
         Start::Hertz | Start::Pressure { .. } => {
             // The pressure and its (condensed) deflection.
-            let (p, hc): (&dyn Fn(f64, f64) -> f64, f64) = match start {
-                Start::Pressure { p, hc, .. } => (p, hc),
-                _ => (&hertz, hc_guess(scene)),
-            };
+            let (p, hc) = start.pressure(scene);
             for (j, &n) in comp.cols.iter().enumerate() {
                 let c = mesh.nodes[n as usize];
                 x0[j] = p(c[0], c[2]);
@@ -477,14 +482,10 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
     let k = assembly::assemble_stiffness(comm, mesh, part, dofs, ctx.rank, eq.nu).map_err(pe)?;
-    let hertz = |x: f64, z: f64| hertz_load::hertz_pressure(x, z);
-    let (p, hc): (&dyn Fn(f64, f64) -> f64, f64) = match start {
-        Start::Pressure { p, hc, .. } => (p, hc),
-        _ => (&hertz, hc_guess(scene)),
-    };
     let x0 = match start {
         Start::Previous(prev) => prev.to_vec(),
         Start::Hertz | Start::Pressure { .. } => {
+            let (p, hc) = start.pressure(scene);
             let u_dry = elastic_start(comm, ctx, mesh, part, dofs, &k, eq.nu, p).map_err(pe)?;
             // Initial iterate: the start pressure, its displacement, H0 from the central film.
             let mut x0 = vec![0.0; layout.total()];
