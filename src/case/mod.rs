@@ -202,6 +202,13 @@ impl Scene {
                     ));
                 }
             }
+            if (m.patch_r_min > 0.0 || m.patch_r_max > 0.0) && m.patch_r_max <= m.patch_r_min {
+                return Err(not_allowed(
+                    "mesh.patch_r_max",
+                    m.patch_r_max,
+                    format!("must exceed mesh.patch_r_min = {} (units of a) when the patch has radial limits", fmt_num(m.patch_r_min)),
+                ));
+            }
         }
 
         let e = &self.effects;

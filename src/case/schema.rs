@@ -735,6 +735,11 @@ pub struct MeshSettings {
     pub patch_x_max: f64,
     pub patch_z_min: f64,
     pub patch_z_max: f64,
+    /// Radial limits of the patch (units of a): with patch_r_max > 0, only the part of the
+    /// rectangle with patch_r_min <= sqrt(X^2 + Z^2) <= patch_r_max is refined; 0 (default):
+    /// the whole rectangle.
+    pub patch_r_min: f64,
+    pub patch_r_max: f64,
 }
 
 impl Default for MeshSettings {
@@ -753,6 +758,8 @@ impl Default for MeshSettings {
             patch_x_max: 0.0,
             patch_z_min: 0.0,
             patch_z_max: 0.0,
+            patch_r_min: 0.0,
+            patch_r_max: 0.0,
         }
     }
 }
@@ -833,6 +840,14 @@ pub const MESH_FIELDS: &[Field] = &[
     f!("patch_x_max", "patch rectangle: highest X (must exceed patch_x_min when patch_size > 0)", "a", Kind::Number(Range::Closed(-8.0, 8.0)), Presence::Default("0")),
     f!("patch_z_min", "patch rectangle: lowest Z", "a", Kind::Number(Range::Closed(-8.0, 8.0)), Presence::Default("0")),
     f!("patch_z_max", "patch rectangle: highest Z (must exceed patch_z_min when patch_size > 0)", "a", Kind::Number(Range::Closed(-8.0, 8.0)), Presence::Default("0")),
+    f!("patch_r_min", "patch: refine only where sqrt(X^2 + Z^2) >= patch_r_min (with patch_r_max > 0)", "a", Kind::Number(Range::Closed(0.0, 8.0)), Presence::Default("0")),
+    f!(
+        "patch_r_max",
+        "patch: refine only where sqrt(X^2 + Z^2) <= patch_r_max, a sector of an annulus for a side lobe along the contact edge (must exceed patch_r_min; 0: the whole rectangle)",
+        "a",
+        Kind::Number(Range::Closed(0.0, 8.0)),
+        Presence::Default("0")
+    ),
 ];
 
 // ---------------------------------------------------------------------------------------

@@ -645,6 +645,8 @@ fn command_line_overrides_are_validated_like_the_file() {
     assert_eq!(e, "mesh.patch_z_max = -1 is not allowed: must exceed mesh.patch_z_min = -0.9 (units of a) when mesh.patch_size > 0");
     // Without a patch size the rectangle is unused (its defaults are empty).
     assert!(set(&["mesh.patch_size=0"]).is_ok());
+    let e = set(&["mesh.patch_size=0.01", "mesh.patch_x_min=-0.4", "mesh.patch_x_max=0.4", "mesh.patch_z_min=-1.0", "mesh.patch_z_max=-0.9", "mesh.patch_r_min=0.97"]).unwrap_err().to_string();
+    assert_eq!(e, "mesh.patch_r_max = 0 is not allowed: must exceed mesh.patch_r_min = 0.97 (units of a) when the patch has radial limits");
     let s = set(&["operating.load=2000", "effects.friction=none", "mesh.core_size=0.0625"]).unwrap();
     assert_eq!(s.operating.load, 2000.0);
     assert_eq!(s.effects.friction, FrictionModel::Off);

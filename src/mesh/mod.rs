@@ -71,6 +71,9 @@ pub fn generate(spec: &MeshSpec) -> Result<Mesh, String> {
     Ok(assemble::assemble(refined_bisector(spec, h), spec, h))
 }
 
+/// A rectangle refinement: bounding box corners, element size, optional radial limits.
+type BoxRefinement = ([f64; 3], [f64; 3], f64, Option<(f64, f64)>);
+
 /// Kuhn coarse mesh refined by Maubach bisection + closure until every tet
 /// satisfies `longest_edge <= sqrt(3) (h + growth d)`.
 fn refined_bisector(spec: &MeshSpec, h: f64) -> refine::Bisector {
@@ -79,15 +82,28 @@ fn refined_bisector(spec: &MeshSpec, h: f64) -> refine::Bisector {
     let (rlo, rhi) = ([r.x0, 0.0, r.z0], [r.x1, 0.0, r.z1]);
     let g = spec.growth;
     let dyadic = spec::dyadic_size;
-    // Rectangle refinements (the core square and the patch): bounding box and size.
-    let boxes: Vec<([f64; 3], [f64; 3], f64)> =
-        spec.core.iter().chain(&spec.patch).map(|&(c, size)| ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], dyadic(size))).collect();
+    // Rectangle refinements (the core square and the patch): bounding box, size and, for
+    // the patch, the radial limits it may carry.
+    let boxes: Vec<BoxRefinement> = spec
+        .core
+        .iter()
+        .map(|&c| (c, None))
+        .chain(spec.patch.iter().map(|&p| (p, spec.patch_radii)))
+        .map(|((c, size), radii)| ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], dyadic(size), radii))
+        .collect();
     let ring = spec.ring.map(|r| (r.inner, r.outer, dyadic(r.size)));
     b.refine_and_close(|v, t| {
         let d = refine::bbox_distance(v, t, &rlo, &rhi);
         let mut target = h + g * d;
-        for (lo, hi, hb) in &boxes {
-            target = target.min(hb + g * refine::bbox_distance(v, t, lo, hi));
+        for (lo, hi, hb, radii) in &boxes {
+            // Distance to the rectangle, or to its part inside the annulus: the larger of
+            // the two distances, a lower bound of the distance to the intersection (so the
+            // grading around it is, if anything, finer than asked).
+            let mut db = refine::bbox_distance(v, t, lo, hi);
+            if let Some((r0, r1)) = radii {
+                db = db.max(refine::ring_distance(v, t, *r0, *r1));
+            }
+            target = target.min(hb + g * db);
         }
         if let Some((r0, r1, hr)) = ring {
             target = target.min(hr + g * refine::ring_distance(v, t, r0, r1));

@@ -75,6 +75,10 @@ pub struct MeshSpec {
     /// growth. For a feature that is small and placed: the outlet constriction, the film
     /// next to a spin pole.
     pub patch: Option<(Rect, f64)>,
+    /// Optional radial limits `(r_min, r_max)` of the patch: only the part of the rectangle
+    /// with `r_min <= sqrt(X^2 + Z^2) <= r_max` is refined (a sector of an annulus, for a
+    /// side lobe that follows the contact edge).
+    pub patch_radii: Option<(f64, f64)>,
 }
 
 /// An annulus on the top face, centred on the origin, with its element size.
@@ -103,6 +107,7 @@ impl MeshSpec {
             core: None,
             ring: None,
             patch: None,
+            patch_radii: None,
         }
     }
 
@@ -176,6 +181,11 @@ impl MeshSpec {
             pos("patch size", size)?;
             if !r.is_proper() {
                 return Err(format!("mesh spec: patch rectangle {r:?} is empty or not finite"));
+            }
+        }
+        if let Some((r0, r1)) = self.patch_radii {
+            if !(r0.is_finite() && r1.is_finite() && r0 >= 0.0 && r1 > r0) {
+                return Err(format!("mesh spec: patch radii must satisfy 0 <= r_min < r_max (got r_min {r0}, r_max {r1})"));
             }
         }
         if self.contact_size < COARSE_CELL / f64::from(1u32 << MAX_LEVEL) {

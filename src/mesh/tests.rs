@@ -535,3 +535,36 @@ fn patch_refines_only_its_rectangle() {
     assert!(inside >= 131 && far > 100, "{inside} {far}");
 }
 
+
+#[test]
+fn patch_with_radii_refines_only_its_annular_part() {
+    // The patch rectangle -0.4 <= X <= 0.4, -1.1 <= Z <= -0.3 limited to 0.97 <= r <= 1.0
+    // (a side lobe along the contact edge): triangles touching that part have legs <=
+    // 0.03125; triangles of the rectangle more than 0.25 away from the annulus are
+    // coarser, so the limit is honoured; the mesh stays conforming.
+    let mut s = half_spec();
+    let r = Rect { x0: -0.4, x1: 0.4, z0: -1.1, z1: -0.3 };
+    s.patch = Some((r, 0.03125));
+    s.patch_radii = Some((0.97, 1.0));
+    let m = generate(&s).unwrap();
+    check_graded(&m);
+    let (mut inside, mut away) = (0, 0);
+    let fine = 0.03125 * 2f64.sqrt() * (1.0 + 1e-12);
+    for c in &m.contact_tris {
+        let p: Vec<[f64; 3]> = c[..3].iter().map(|&v| m.nodes[v as usize]).collect();
+        let edge = |a: usize, b: usize| ((p[a][0] - p[b][0]).powi(2) + (p[a][2] - p[b][2]).powi(2)).sqrt();
+        let longest = edge(0, 1).max(edge(1, 2)).max(edge(2, 0));
+        let in_rect = p.iter().all(|q| q[0] >= r.x0 && q[0] <= r.x1 && q[2] >= r.z0 && q[2] <= r.z1);
+        let radii: Vec<f64> = p.iter().map(|q| q[0].hypot(q[2])).collect();
+        let (rmin, rmax) = radii.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &q| (a.min(q), b.max(q)));
+        if in_rect && rmax >= 0.97 && rmin <= 1.0 {
+            assert!(longest <= fine, "triangle across the annular patch has edge {longest}");
+            inside += 1;
+        } else if in_rect && (0.97 - rmax).max(rmin - 1.0) > 0.25 {
+            assert!(longest > fine, "triangle of the rectangle {}a off the annulus has edge {longest}", (0.97 - rmax).max(rmin - 1.0));
+            away += 1;
+        }
+    }
+    // The annular part: about 0.8 x 0.03 / (0.03125^2 / 2) = 49 triangles at least.
+    assert!(inside >= 49 && away >= 4, "{inside} {away}");
+}
