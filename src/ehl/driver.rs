@@ -373,7 +373,7 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     let t1 = std::time::Instant::now();
     let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);
     ctx.log(format!("Newton from {label}: {} unknowns ({} P, 1 H0), {} Jacobian", cl.total(), cl.n_p, if comp.is_rigid() { "sparse" } else { "dense" }));
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, matches!(start, Start::Hertz), &j, (lo, hi), cl.local(ctx.rank))?;
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, matches!(start, Start::Hertz), !matches!(start, Start::Previous(_)), &j, (lo, hi), cl.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
     let uy = system.uy(&out.x);
@@ -527,7 +527,7 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
         }
     }
     let (lo, hi) = (layout.ranges[ctx.rank], layout.ranges[ctx.rank + 1]);
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, matches!(start, Start::Hertz), &j, (lo, hi), layout.local(ctx.rank))?;
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, matches!(start, Start::Hertz), !matches!(start, Start::Previous(_)), &j, (lo, hi), layout.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     Ok(EhlSolution { x: out.x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s, coupling: "monolithic" })
 }
@@ -574,13 +574,13 @@ type SceneAt = Box<dyn Fn(&mut Scene, f64)>;
 type SolveAt<'a> = dyn Fn(&Scene, &Homotopy, f64, &mut dyn EhlProblem, &[f64], String) -> Result<(SolveReport, Option<Vec<f64>>), String> + 'a;
 
 /// Newton from `x0` (described by `label`) at the scene's operating point. With
-/// `continuation` set, a stiff cavitation penalty (xi > 1e3) is solved at xi = 1e3 first;
-/// if that fails, a continuation in the tilt angle (spin), then in pressure-viscosity, then
+/// `stage_penalty` set, a stiff cavitation penalty (xi > 1e3) is solved at xi = 1e3 first;
+/// with `continuation` set, if that fails, a continuation in the tilt angle (spin), then in pressure-viscosity, then
 /// in load, then in speed, from a milder problem to the scene's (at xi = 1e3); and last the
 /// penalty from 1e3 to the scene's xi. Each step is logged and kept in the path.
 /// Returns the converged iterate (gathered) or an error naming the path taken.
 #[allow(clippy::too_many_arguments)]
-fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], label: &str, continuation: bool, j: &Matrix, (lo, hi): (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
+fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], label: &str, continuation: bool, stage_penalty: bool, j: &Matrix, (lo, hi): (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let x = Vector::new(comm, local).map_err(pe)?;
@@ -609,10 +609,12 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     // with the ring halved), while from the xi = 1e3 solution the cavitated set is already
     // right. Every other continuation runs at xi = 1e3 too, where Newton converges from the
     // Hertz start on every mesh measured (README "The cavitation penalty and the finer ring").
-    // A warm start (no continuation) goes straight to the scene's xi.
+    // A pressure from another mesh (`stage_penalty` without `continuation`) is staged the same
+    // way: its cavitation boundary is the coarser mesh's. A previous state of the same mesh
+    // (a sweep) goes straight to the scene's xi.
     let target = scene.operating.load;
     let xi = penalty(scene);
-    let staged = continuation && xi > PENALTY_START;
+    let staged = stage_penalty && xi > PENALTY_START;
     let mut base = scene.clone();
     if staged {
         base.reynolds.penalty = PENALTY_START;
