@@ -35,8 +35,6 @@ pub struct EarlierRun {
     a: f64,
     /// The earlier run's central film (m).
     pub hc_m: f64,
-    /// Contact nodes of the earlier mesh, for the log.
-    pub contact_nodes: usize,
 }
 
 impl EarlierRun {
@@ -91,8 +89,7 @@ impl EarlierRun {
             p_pa[n as usize] = v[2];
         }
         let locator = ContactLocator::new(&mesh);
-        let contact_nodes = mesh.contact_nodes.len();
-        Ok(EarlierRun { dir: dir.to_path_buf(), mesh, locator, p_pa, a, hc_m, contact_nodes })
+        Ok(EarlierRun { dir: dir.to_path_buf(), mesh, locator, p_pa, a, hc_m })
     }
 
     /// Newton from this run's pressure for `scene` (whose scales may differ from the
@@ -101,7 +98,7 @@ impl EarlierRun {
         let hertz = scene.hertz();
         let (a, ph) = (hertz.a, hertz.ph);
         let p = |x: f64, z: f64| self.pressure_at(x * a, z * a) / ph;
-        let label = format!("the pressure of {} ({} contact nodes)", self.dir.display(), self.contact_nodes);
+        let label = format!("the pressure of {} ({} contact nodes)", self.dir.display(), self.mesh.contact_nodes.len());
         let hc = self.hc_m / scene.scales().film_scale();
         solver.solve_from(ctx, scene, crate::ehl::driver::Start::Pressure { p: &p, hc, label: &label })
     }

@@ -62,6 +62,19 @@ impl<'s> Start<'s> {
         }
     }
 
+    /// Whether Newton's failure from this start leads to the automatic continuation: only
+    /// from the Hertz start (another start falls back to the Hertz start instead).
+    fn continues(&self) -> bool {
+        matches!(self, Start::Hertz)
+    }
+
+    /// Whether a stiff cavitation penalty is reached through xi = 1e3 from this start: from
+    /// the Hertz start and from another mesh's pressure (its cavitation boundary is the
+    /// coarser mesh's), not from a previous state of the same mesh (a sweep).
+    fn stages_penalty(&self) -> bool {
+        !matches!(self, Start::Previous(_))
+    }
+
     fn label(&self) -> &str {
         match self {
             Start::Hertz => "the Hertz start",
@@ -373,7 +386,7 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     let t1 = std::time::Instant::now();
     let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);
     ctx.log(format!("Newton from {label}: {} unknowns ({} P, 1 H0), {} Jacobian", cl.total(), cl.n_p, if comp.is_rigid() { "sparse" } else { "dense" }));
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, matches!(start, Start::Hertz), !matches!(start, Start::Previous(_)), &j, (lo, hi), cl.local(ctx.rank))?;
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.continues(), start.stages_penalty(), &j, (lo, hi), cl.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
     let uy = system.uy(&out.x);
@@ -527,7 +540,7 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
         }
     }
     let (lo, hi) = (layout.ranges[ctx.rank], layout.ranges[ctx.rank + 1]);
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, matches!(start, Start::Hertz), !matches!(start, Start::Previous(_)), &j, (lo, hi), layout.local(ctx.rank))?;
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.continues(), start.stages_penalty(), &j, (lo, hi), layout.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     Ok(EhlSolution { x: out.x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s, coupling: "monolithic" })
 }
@@ -609,9 +622,8 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     // with the ring halved), while from the xi = 1e3 solution the cavitated set is already
     // right. Every other continuation runs at xi = 1e3 too, where Newton converges from the
     // Hertz start on every mesh measured (README "The cavitation penalty and the finer ring").
-    // A pressure from another mesh (`stage_penalty` without `continuation`) is staged the same
-    // way: its cavitation boundary is the coarser mesh's. A previous state of the same mesh
-    // (a sweep) goes straight to the scene's xi.
+    // A pressure from another mesh is staged the same way, a previous state of the same mesh
+    // (a sweep) goes straight to the scene's xi ([`Start::stages_penalty`]).
     let target = scene.operating.load;
     let xi = penalty(scene);
     let staged = stage_penalty && xi > PENALTY_START;

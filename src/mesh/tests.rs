@@ -476,6 +476,19 @@ fn report() {
     }
 }
 
+/// The corners of contact triangle `c` and its longest edge in the (x, z) plane.
+fn face_triangle(m: &Mesh, c: &[u32; 6]) -> (Vec<[f64; 3]>, f64) {
+    let p: Vec<[f64; 3]> = c[..3].iter().map(|&v| m.nodes[v as usize]).collect();
+    let edge = |a: usize, b: usize| ((p[a][0] - p[b][0]).powi(2) + (p[a][2] - p[b][2]).powi(2)).sqrt();
+    let longest = edge(0, 1).max(edge(1, 2)).max(edge(2, 0));
+    (p, longest)
+}
+
+/// The smallest and largest radius sqrt(x^2 + z^2) of the points.
+fn radius_range(p: &[[f64; 3]]) -> (f64, f64) {
+    p.iter().map(|q| q[0].hypot(q[2])).fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)))
+}
+
 #[test]
 fn ring_refines_only_around_the_hertz_circle() {
     // Half domain, h_c = 0.25 with a 0.0625 ring on 0.85 <= r <= 1.15.
@@ -485,11 +498,8 @@ fn ring_refines_only_around_the_hertz_circle() {
     check_graded(&m);
     let (mut in_ring, mut centre) = (0, 0);
     for c in &m.contact_tris {
-        let p: Vec<[f64; 3]> = c[..3].iter().map(|&v| m.nodes[v as usize]).collect();
-        let edge = |a: usize, b: usize| ((p[a][0] - p[b][0]).powi(2) + (p[a][2] - p[b][2]).powi(2)).sqrt();
-        let longest = edge(0, 1).max(edge(1, 2)).max(edge(2, 0));
-        let r = |q: &[f64; 3]| q[0].hypot(q[2]);
-        let (rmin, rmax) = p.iter().map(r).fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+        let (p, longest) = face_triangle(&m, c);
+        let (rmin, rmax) = radius_range(&p);
         if rmax >= 0.85 && rmin <= 1.15 {
             // A triangle touching the ring has legs of at most the ring size.
             assert!(longest <= 0.0625 * 2f64.sqrt() * (1.0 + 1e-12), "triangle at r in [{rmin}, {rmax}] has edge {longest}");
@@ -517,9 +527,7 @@ fn patch_refines_only_its_rectangle() {
     let (mut inside, mut far) = (0, 0);
     let fine = 0.03125 * 2f64.sqrt() * (1.0 + 1e-12);
     for c in &m.contact_tris {
-        let p: Vec<[f64; 3]> = c[..3].iter().map(|&v| m.nodes[v as usize]).collect();
-        let edge = |a: usize, b: usize| ((p[a][0] - p[b][0]).powi(2) + (p[a][2] - p[b][2]).powi(2)).sqrt();
-        let longest = edge(0, 1).max(edge(1, 2)).max(edge(2, 0));
+        let (p, longest) = face_triangle(&m, c);
         let (x0, x1) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| (a.min(q[0]), b.max(q[0])));
         let (z0, z1) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| (a.min(q[2]), b.max(q[2])));
         let gap = (r.x0 - x1).max(x0 - r.x1).max(0.0).hypot((r.z0 - z1).max(z0 - r.z1).max(0.0));
@@ -534,7 +542,6 @@ fn patch_refines_only_its_rectangle() {
     // The patch holds 0.8 x 0.08 / (0.03125^2 / 2) = 131 triangles at least.
     assert!(inside >= 131 && far > 100, "{inside} {far}");
 }
-
 
 #[test]
 fn patch_with_radii_refines_only_its_annular_part() {
@@ -551,12 +558,9 @@ fn patch_with_radii_refines_only_its_annular_part() {
     let (mut inside, mut away) = (0, 0);
     let fine = 0.03125 * 2f64.sqrt() * (1.0 + 1e-12);
     for c in &m.contact_tris {
-        let p: Vec<[f64; 3]> = c[..3].iter().map(|&v| m.nodes[v as usize]).collect();
-        let edge = |a: usize, b: usize| ((p[a][0] - p[b][0]).powi(2) + (p[a][2] - p[b][2]).powi(2)).sqrt();
-        let longest = edge(0, 1).max(edge(1, 2)).max(edge(2, 0));
+        let (p, longest) = face_triangle(&m, c);
         let in_rect = p.iter().all(|q| q[0] >= r.x0 && q[0] <= r.x1 && q[2] >= r.z0 && q[2] <= r.z1);
-        let radii: Vec<f64> = p.iter().map(|q| q[0].hypot(q[2])).collect();
-        let (rmin, rmax) = radii.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &q| (a.min(q), b.max(q)));
+        let (rmin, rmax) = radius_range(&p);
         if in_rect && rmax >= 0.97 && rmin <= 1.0 {
             assert!(longest <= fine, "triangle across the annular patch has edge {longest}");
             inside += 1;
