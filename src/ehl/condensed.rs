@@ -6,7 +6,7 @@
 //! elimination of U). The Jacobian is dense in P (every pressure deflects every face
 //! node): dR/dP + dR/dH C, assembled row by row into a dense-pattern AIJ matrix that MUMPS
 //! factorises; its size is set by the Reynolds mesh alone, not by the 3D mesh.
-use super::system::{p2_tri_weights, penalty_law, tri_area, EhlParams, Lubricant, CAVITATION_SMOOTHING};
+use super::system::{clip_pressure_step, p2_tri_weights, penalty_law, pressure_step_floor, tri_area, EhlParams, Lubricant, CAVITATION_SMOOTHING};
 use super::system::EhlProblem;
 use crate::mesh::Mesh;
 use crate::petsc::snes::{Eval, Problem};
@@ -605,6 +605,19 @@ impl Problem for CondensedSystem<'_> {
         let idx: Vec<i32> = (lo as i32..hi as i32).collect();
         f.set_values(&idx, &r, true)?;
         Ok(Eval::Ok)
+    }
+
+    fn clip_step(&mut self, x: &[f64], y: &mut [f64]) -> Result<usize> {
+        let Some(floor) = pressure_step_floor() else { return Ok(0) };
+        let mut n = 0;
+        for i in 0..self.layout.n_p {
+            let c = clip_pressure_step(x[i], y[i], floor);
+            if c != y[i] {
+                y[i] = c;
+                n += 1;
+            }
+        }
+        Ok(n)
     }
 
     fn limit_step(&mut self, x: &[f64], y: &[f64]) -> Result<f64> {

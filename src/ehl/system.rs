@@ -37,7 +37,17 @@ pub fn p2_tri_weights(area: f64) -> [f64; 6] {
     [0.0, 0.0, 0.0, area / 3.0, area / 3.0, area / 3.0]
 }
 
-pub use crate::reynolds::cavitation::{penalty_law, CAVITATION_SMOOTHING};
+pub use crate::reynolds::cavitation::{clip_pressure_step, penalty_law, CAVITATION_SMOOTHING, PRESSURE_STEP_FLOOR};
+
+/// The floor of a Newton step's nodal pressure ([`PRESSURE_STEP_FLOOR`]); the developer
+/// switch `EHL_P_FLOOR` sets another value, or `off`.
+pub fn pressure_step_floor() -> Option<f64> {
+    match std::env::var("EHL_P_FLOOR") {
+        Ok(v) if v == "off" => None,
+        Ok(v) => Some(v.parse().expect("EHL_P_FLOOR: a number or off")),
+        Err(_) => Some(PRESSURE_STEP_FLOOR),
+    }
+}
 
 /// Lubricant laws in dimensionless form: eta_bar(P), rho_bar(P) with their P-derivatives.
 pub struct Lubricant {
@@ -418,6 +428,23 @@ impl Problem for EhlSystem<'_> {
 
     /// Fraction to the boundary: the Newton update may shrink the film at any contact node
     /// to no less than `FILM_KEEP` of its current value (H stays positive).
+    fn clip_step(&mut self, x: &[f64], y: &mut [f64]) -> Result<usize> {
+        let Some(floor) = pressure_step_floor() else { return Ok(0) };
+        let mut n = 0;
+        for &d in self.layout.p.iter().filter(|&&d| d >= 0) {
+            let i = d as usize;
+            let c = clip_pressure_step(x[i], y[i], floor);
+            if c != y[i] {
+                y[i] = c;
+                n += 1;
+            }
+        }
+        if n > 0 && std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
+            eprintln!("EHL_DEBUG pressure step clipped at {n} nodes (floor {floor})");
+        }
+        Ok(n)
+    }
+
     fn limit_step(&mut self, x: &[f64], y: &[f64]) -> Result<f64> {
         const FILM_KEEP: f64 = 0.2;
         if std::env::var_os("EHL_NO_LIMIT").is_some() {

@@ -10,12 +10,14 @@ pub const COARSE_CELL: f64 = 16.0;
 pub const MAX_LEVEL: u32 = 20;
 
 /// The element size the mesher uses for a requested `size` (units of a): the largest
-/// 16/2^L <= size (to 1e-12 relative, so 0.0625 stays 0.0625), 0 <= L <= MAX_LEVEL. Every
-/// refinement level of the Kuhn grid halves the cell, so only these sizes exist.
+/// 16/2^L <= size (to 1e-5 relative, so 0.0625 stays 0.0625 and a size written with six
+/// significant digits, 0.00195312 for 2^-9, is that size and not the next level down),
+/// 0 <= L <= MAX_LEVEL. Every refinement level of the Kuhn grid halves the cell, so only
+/// these sizes exist.
 pub fn dyadic_size(size: f64) -> f64 {
     let mut h = COARSE_CELL;
     let mut level = 0;
-    while h > size * (1.0 + 1e-12) && level < MAX_LEVEL {
+    while h > size * (1.0 + 1e-5) && level < MAX_LEVEL {
         h *= 0.5;
         level += 1;
     }
@@ -325,6 +327,10 @@ mod tests {
         assert_eq!(s.actual_contact_size(), 0.0625);
         assert_eq!(dyadic_size(0.0625 * (1.0 - 1e-14)), 0.0625);
         assert_eq!(dyadic_size(0.07), 0.0625);
+        // Six significant digits of 2^-9 (what `awk '{print r / 2}'` wrote for half of
+        // 2^-8) are 2^-9, not 2^-10; 0.1 % below a level is the level below.
+        assert_eq!(dyadic_size(0.00195312), 0.001953125);
+        assert_eq!(dyadic_size(0.0625 * 0.999), 0.03125);
         assert_eq!(dyadic_size(100.0), 16.0);
         assert_eq!(dyadic_size(0.0), COARSE_CELL / f64::from(1u32 << MAX_LEVEL));
     }

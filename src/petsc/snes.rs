@@ -32,6 +32,12 @@ pub trait Problem {
     fn limit_step(&mut self, _x: &[f64], _y: &[f64]) -> Result<f64> {
         Ok(1.0)
     }
+    /// Component-wise change of the Newton direction `y`, called before [`Problem::limit_step`]
+    /// (e.g. clipping one unknown's update at a bound); returns how many components changed.
+    /// Every rank gets the same whole `x` and `y` and must change `y` the same way.
+    fn clip_step(&mut self, _x: &[f64], _y: &mut [f64]) -> Result<usize> {
+        Ok(0)
+    }
 }
 
 struct Context<'a> {
@@ -118,13 +124,17 @@ unsafe extern "C" fn precheck(_ls: ffi::SNESLineSearch, x: ffi::Vec, y: ffi::Vec
     let run = || -> Result<bool> {
         let xv = std::mem::ManuallyDrop::new(Vector { raw: x });
         let yv = std::mem::ManuallyDrop::new(Vector { raw: y });
-        let (xa, ya) = (xv.gather_all()?, yv.gather_all()?);
+        let (xa, mut ya) = (xv.gather_all()?, yv.gather_all()?);
+        let clipped = ctx.problem.clip_step(&xa, &mut ya)?;
+        if clipped > 0 {
+            let (lo, hi) = yv.ownership()?;
+            yv.set_local_values(&ya[lo..hi])?;
+        }
         let s = ctx.problem.limit_step(&xa, &ya)?;
         if s < 1.0 {
             pcall!(ffi::VecScale(y, s))?;
-            return Ok(true);
         }
-        Ok(false)
+        Ok(clipped > 0 || s < 1.0)
     };
     match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
         Ok(Ok(ch)) => {

@@ -654,3 +654,20 @@ fn crosswind_diffusion_acts_across_the_streamlines_only() {
     assert!(close(&rc, &ri), "crosswind {rc:?} vs isotropic {ri:?}");
     assert!(!close(&rc, &r0), "the crosswind term did nothing across the stream");
 }
+
+#[test]
+fn a_pressure_step_stops_at_the_floor_and_leaves_other_steps_alone() {
+    use super::cavitation::clip_pressure_step;
+    let floor = -0.1;
+    // heavy-3gpa's side lobe from a coarser mesh: 0.3 p_H predicted to fall to -1 p_H.
+    let y = clip_pressure_step(0.3, 1.3, floor);
+    assert!((0.3 - y - floor).abs() < 1e-15, "new P = {}", 0.3 - y);
+    // A step that stays above the floor, up or down, is kept exactly (also into the
+    // penalty's converged range, -O(1/xi)).
+    for (p, y) in [(0.3, 0.2), (0.3, 0.3009), (-0.05, -0.4), (1e-4, 0.0601)] {
+        assert_eq!(clip_pressure_step(p, y, floor), y);
+    }
+    // Below the floor already: may rise, may not fall further.
+    assert_eq!(clip_pressure_step(-0.2, -0.15, floor), -0.15);
+    assert_eq!(clip_pressure_step(-0.2, 0.5, floor), 0.0);
+}
