@@ -146,11 +146,19 @@ fn elastic_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &
         std::array::from_fn(|i| (0..6).map(|j| m[i][j] * p[j]).sum())
     };
     let b = assembly::assemble_pressure_load(comm, mesh, part, dofs, ctx.rank, assembly::traction_factor(nu), &nodal)?;
-    let ksp = Ksp::new(comm, k)?;
+    // K is symmetric positive definite (constrained dofs are eliminated): a MUMPS Cholesky
+    // under its own prefix, so the Newton solver's flags (-ksp_type gmres, ...) do not reach it.
+    for (k, v) in [("ksp_type", "preonly"), ("pc_type", "cholesky"), ("pc_factor_mat_solver_type", "mumps"), ("mat_mumps_icntl_7", "4")] {
+        petsc::options::set_default(&format!("-{START_PREFIX}{k}"), v)?;
+    }
+    let ksp = Ksp::with_prefix(comm, k, START_PREFIX)?;
     let u = Vector::new(comm, dofs.local(ctx.rank))?;
     ksp.solve(&b, &u)?;
     u.gather_all()
 }
+
+/// Options prefix of the start's elastic solve (`-start_pc_type`, `-start_mat_mumps_icntl_7`).
+const START_PREFIX: &str = "start_";
 
 /// The scene's dimensionless entrainment velocity (Um, Wm)/Ue as a function of (X, Z).
 fn velocity_field(scene: &Scene) -> Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync> {
@@ -250,7 +258,7 @@ impl<'a> EhlSolver<'a> {
         let p_nodes = pressure_nodes(mesh, layout);
         let monolithic = !rigid && monolithic(scene.reynolds.coupling, p_nodes.len(), scene.is_sweep())?;
         if monolithic {
-            ctx.log(format!("coupling: monolithic (reynolds.coupling = \"{}\", {} pressure unknowns): U, P and H0 in one sparse matrix, a MUMPS LU at every Newton step", scene.reynolds.coupling, p_nodes.len()));
+            ctx.log(format!("coupling: monolithic (reynolds.coupling = \"{}\", {} pressure unknowns): U, P and H0 in one sparse matrix, a MUMPS LU every third Newton step and GMRES on it in between", scene.reynolds.coupling, p_nodes.len()));
             // The condensed path picks its solver by the Jacobian's type (see `solve_condensed`);
             // a convergence study may have run it before in this process.
             petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
@@ -261,6 +269,7 @@ impl<'a> EhlSolver<'a> {
             // The condensation's 3D Cholesky has its own prefix and keeps PORD.
             petsc::options::set_default("-elastic_mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
         }
+        set_newton_linear_solver(monolithic).map_err(|e| e.to_string())?;
         let t0 = std::time::Instant::now();
         let comp = if rigid {
             ctx.log(format!("rigid solids: no elastic unknowns, H = H0 + (X^2 + Z^2)/2; sparse Newton on {} pressure unknowns", p_nodes.len()));
@@ -965,6 +974,35 @@ pub fn set_newton_defaults() -> petsc::Result<()> {
     set_default("-snes_atol", "1e-11")?;
     // A tiny step is not convergence: only the residual norm decides.
     set_default("-snes_stol", "0")?;
+    Ok(())
+}
+
+/// The linear solve of a Newton step, by coupling (each overridable by PETSc options).
+///
+/// Monolithic: the MUMPS LU of the sparse Jacobian is rebuilt every third Newton step and
+/// GMRES solves on the last one, to the Eisenstat-Walker tolerance (inexact Newton: loose
+/// while the residual is large, tight near the solution). The LU is 87 % of a monolithic
+/// step (table2-ue2, narrow ring 0.015625 a: 5.1 s per factorisation, 0.16 s per
+/// triangular solve); from the Hertz start this took 17 iterations and 59 s instead of 13
+/// and 102 s, from level 1's pressure 10-11 and 41-42 s instead of 9 and 66-71 s, to the
+/// same film (README "Solver options"). Exact Newton: `-snes_lag_preconditioner 1
+/// -ksp_type preonly -snes_ksp_ew false`.
+///
+/// Condensed: a fresh dense LU every step, one back-substitution (the ScaLAPACK LU of the
+/// Table 2 scenes is 0.4 s, about what a stale LU costs in GMRES iterations).
+///
+/// Set with `set_ours`, so that a process switching coupling (a convergence study) gets
+/// each coupling's own, while the user's flags stay.
+pub fn set_newton_linear_solver(monolithic: bool) -> petsc::Result<()> {
+    use petsc::options::set_ours;
+    let settings: &[(&str, &str)] = if monolithic {
+        &[("-ksp_type", "gmres"), ("-ksp_gmres_restart", "100"), ("-snes_lag_preconditioner", "3"), ("-snes_ksp_ew", "true")]
+    } else {
+        &[("-ksp_type", "preonly"), ("-snes_lag_preconditioner", "1"), ("-snes_ksp_ew", "false")]
+    };
+    for (k, v) in settings {
+        set_ours(k, v)?;
+    }
     Ok(())
 }
 

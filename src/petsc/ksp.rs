@@ -37,9 +37,19 @@ pub struct Ksp {
 impl Ksp {
     /// Creates a solver for operator `a`, configured from the options database.
     pub fn new(comm: ffi::MPI_Comm, a: &Matrix) -> Result<Ksp> {
+        Ksp::with_prefix(comm, a, "")
+    }
+
+    /// Creates a solver for operator `a` that reads its options under `prefix`
+    /// (`-{prefix}ksp_type`, `-{prefix}mat_mumps_icntl_7`, ...).
+    pub fn with_prefix(comm: ffi::MPI_Comm, a: &Matrix, prefix: &str) -> Result<Ksp> {
         let mut raw: ffi::KSP = std::ptr::null_mut();
         pcall!(ffi::KSPCreate(comm, &mut raw))?;
         let k = Ksp { raw };
+        if !prefix.is_empty() {
+            let c = std::ffi::CString::new(prefix).map_err(|_| rust_error(format!("options prefix {prefix:?} contains a NUL byte")))?;
+            pcall!(ffi::KSPSetOptionsPrefix(k.raw, c.as_ptr()))?;
+        }
         pcall!(ffi::KSPSetOperators(k.raw, a.raw, a.raw))?;
         pcall!(ffi::KSPSetFromOptions(k.raw))?;
         Ok(k)
