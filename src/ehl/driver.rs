@@ -62,8 +62,9 @@ impl<'s> Start<'s> {
         }
     }
 
-    /// How Newton proceeds from this start.
-    fn policy(&self) -> Policy {
+    /// How Newton proceeds from this start; `reuse_lu`: the monolithic coupling may reuse
+    /// its LU over Newton steps (see [`Policy::reuses_lu`]).
+    fn policy(&self, reuse_lu: bool) -> Policy {
         Policy {
             // Only from the Hertz start: another start falls back to the Hertz start instead.
             continues: matches!(self, Start::Hertz),
@@ -74,6 +75,7 @@ impl<'s> Start<'s> {
                 Start::Pressure { .. } => "l2",
                 _ => "bt",
             },
+            reuses_lu: reuse_lu && !matches!(self, Start::Hertz),
         }
     }
 
@@ -103,6 +105,14 @@ struct Policy {
     /// (DIVERGED_FUNCTION_DOMAIN: it does not backtrack out of the film's domain), and on
     /// the Table 2 scenes it costs 0-2 iterations more.
     line_search: &'static str,
+    /// The MUMPS LU is rebuilt every third Newton step, GMRES solving on it in between
+    /// ([`set_newton_linear_solver`]); otherwise an LU at every step (exact Newton). Only
+    /// on the monolithic coupling and from a start near the solution (another mesh's
+    /// pressure, a previous operating point): from the Hertz start the inexact steps cost
+    /// the hard scenes their convergence (spin-0.33deg: plain Newton ran out of its 30
+    /// iterations at residual 5e-4, where exact Newton converges in 24, and the tilt
+    /// continuation is not available on the monolithic coupling).
+    reuses_lu: bool,
 }
 
 /// Dimensionless lubricant laws of the scene.
@@ -258,7 +268,7 @@ impl<'a> EhlSolver<'a> {
         let p_nodes = pressure_nodes(mesh, layout);
         let monolithic = !rigid && monolithic(scene.reynolds.coupling, p_nodes.len(), scene.is_sweep())?;
         if monolithic {
-            ctx.log(format!("coupling: monolithic (reynolds.coupling = \"{}\", {} pressure unknowns): U, P and H0 in one sparse matrix, a MUMPS LU every third Newton step and GMRES on it in between", scene.reynolds.coupling, p_nodes.len()));
+            ctx.log(format!("coupling: monolithic (reynolds.coupling = \"{}\", {} pressure unknowns): U, P and H0 in one sparse matrix, a MUMPS LU at every Newton step (every third step, GMRES in between, from a start near the solution)", scene.reynolds.coupling, p_nodes.len()));
             // The condensed path picks its solver by the Jacobian's type (see `solve_condensed`);
             // a convergence study may have run it before in this process.
             petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
@@ -269,7 +279,6 @@ impl<'a> EhlSolver<'a> {
             // The condensation's 3D Cholesky has its own prefix and keeps PORD.
             petsc::options::set_default("-elastic_mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
         }
-        set_newton_linear_solver(monolithic).map_err(|e| e.to_string())?;
         let t0 = std::time::Instant::now();
         let comp = if rigid {
             ctx.log(format!("rigid solids: no elastic unknowns, H = H0 + (X^2 + Z^2)/2; sparse Newton on {} pressure unknowns", p_nodes.len()));
@@ -313,19 +322,27 @@ impl<'a> EhlSolver<'a> {
     /// Solves the scene's operating point from `start`; when Newton fails from a start
     /// other than the Hertz start, the solve starts over from the Hertz start (with its
     /// automatic continuation). Collective.
+    ///
+    /// On the monolithic coupling a start other than the Hertz start first reuses the LU
+    /// over Newton steps ([`Policy::reuses_lu`]); if that fails, the same start is solved
+    /// again with an LU at every step before the Hertz start is tried.
     pub fn solve_from(&self, ctx: &Context, scene: &Scene, start: Start) -> Result<EhlSolution, String> {
-        let once = |start: Start| match &self.comp {
-            None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start),
+        let once = |start: Start, reuse_lu: bool| match &self.comp {
+            None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, reuse_lu),
             Some(comp) => solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, start),
         };
         if !matches!(start, Start::Hertz) {
-            match once(start) {
-                Ok(s) => return Ok(s),
-                Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
-                Err(e) => ctx.log(format!("Newton from {} failed ({e}); starting over from the Hertz start", start.label())),
+            let tries: &[bool] = if self.comp.is_none() { &[true, false] } else { &[false] };
+            for (k, &reuse_lu) in tries.iter().enumerate() {
+                match once(start, reuse_lu) {
+                    Ok(s) => return Ok(s),
+                    Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
+                    Err(e) if k + 1 < tries.len() => ctx.log(format!("Newton from {} with the LU reused over steps failed ({e}); again with an LU at every step", start.label())),
+                    Err(e) => ctx.log(format!("Newton from {} failed ({e}); starting over from the Hertz start", start.label())),
+                }
             }
         }
-        once(Start::Hertz)
+        once(Start::Hertz, false)
     }
 }
 
@@ -416,7 +433,7 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     let t1 = std::time::Instant::now();
     let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);
     ctx.log(format!("Newton from {label}: {} unknowns ({} P, 1 H0), {} Jacobian", cl.total(), cl.n_p, if comp.is_rigid() { "sparse" } else { "dense" }));
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.policy(), &j, (lo, hi), cl.local(ctx.rank))?;
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.policy(false), &j, (lo, hi), cl.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
     let uy = system.uy(&out.x);
@@ -519,7 +536,8 @@ fn rigid_start(ctx: &Context, system: &mut CondensedSystem, x0: &mut [f64], (lo,
 /// The monolithic path: U, P and H0 in one sparse system, from the Hertz start or from a
 /// previous state `start` (same layout).
 #[allow(clippy::too_many_arguments)]
-fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool, start: Start) -> Result<EhlSolution, String> {
+#[allow(clippy::too_many_arguments)]
+fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool, start: Start, reuse_lu: bool) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
@@ -570,7 +588,7 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
         }
     }
     let (lo, hi) = (layout.ranges[ctx.rank], layout.ranges[ctx.rank + 1]);
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.policy(), &j, (lo, hi), layout.local(ctx.rank))?;
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, start.policy(reuse_lu), &j, (lo, hi), layout.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     Ok(EhlSolution { x: out.x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s, coupling: "monolithic" })
 }
@@ -625,8 +643,9 @@ type SolveAt<'a> = dyn Fn(&Scene, &Homotopy, f64, &mut dyn EhlProblem, &[f64], S
 #[allow(clippy::too_many_arguments)]
 fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], label: &str, policy: Policy, j: &Matrix, (lo, hi): (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
     let pe = |e: petsc::PetscError| e.to_string();
-    let Policy { continues: continuation, stages_penalty: stage_penalty, line_search } = policy;
+    let Policy { continues: continuation, stages_penalty: stage_penalty, line_search, reuses_lu } = policy;
     petsc::options::set_ours("-snes_linesearch_type", line_search).map_err(pe)?;
+    set_newton_linear_solver(reuses_lu).map_err(pe)?;
     let comm = petsc::comm_world();
     let x = Vector::new(comm, local).map_err(pe)?;
     let snes = Snes::new(comm, "").map_err(pe)?;
@@ -977,25 +996,29 @@ pub fn set_newton_defaults() -> petsc::Result<()> {
     Ok(())
 }
 
-/// The linear solve of a Newton step, by coupling (each overridable by PETSc options).
+/// The linear solve of a Newton step (each overridable by PETSc options).
 ///
-/// Monolithic: the MUMPS LU of the sparse Jacobian is rebuilt every third Newton step and
+/// `reuse_lu` (the monolithic coupling from a start near the solution, see
+/// [`Policy::reuses_lu`]): the MUMPS LU of the sparse Jacobian is rebuilt every third Newton step and
 /// GMRES solves on the last one, to the Eisenstat-Walker tolerance (inexact Newton: loose
 /// while the residual is large, tight near the solution). The LU is 87 % of a monolithic
 /// step (table2-ue2, narrow ring 0.015625 a: 5.1 s per factorisation, 0.16 s per
-/// triangular solve); from the Hertz start this took 17 iterations and 59 s instead of 13
-/// and 102 s, from level 1's pressure 10-11 and 41-42 s instead of 9 and 66-71 s, to the
-/// same film (README "Solver options"). Exact Newton: `-snes_lag_preconditioner 1
-/// -ksp_type preonly -snes_ksp_ew false`.
+/// triangular solve); from level 1's pressure this took 10-11 iterations and 41-42 s
+/// instead of 9 and 66-71 s, to the same film (README "Solver options"). From the Hertz
+/// start it took 17 iterations and 59 s instead of 13 and 102 s there, but it made
+/// spin-0.33deg fail, so the Hertz start keeps exact Newton (the user can ask for the
+/// reuse everywhere: `-snes_lag_preconditioner 3 -ksp_type gmres -snes_ksp_ew`, and for
+/// exact Newton everywhere: `-snes_lag_preconditioner 1 -ksp_type preonly -snes_ksp_ew false`).
 ///
-/// Condensed: a fresh dense LU every step, one back-substitution (the ScaLAPACK LU of the
-/// Table 2 scenes is 0.4 s, about what a stale LU costs in GMRES iterations).
+/// Otherwise a fresh LU every step and one back-substitution: the condensed coupling (the
+/// ScaLAPACK LU of the Table 2 scenes is 0.4 s, about what a stale LU costs in GMRES
+/// iterations) and the Hertz start.
 ///
-/// Set with `set_ours`, so that a process switching coupling (a convergence study) gets
-/// each coupling's own, while the user's flags stay.
-pub fn set_newton_linear_solver(monolithic: bool) -> petsc::Result<()> {
+/// Set with `set_ours` before every solve, so that each solve of a process gets its own,
+/// while the user's flags stay.
+pub fn set_newton_linear_solver(reuse_lu: bool) -> petsc::Result<()> {
     use petsc::options::set_ours;
-    let settings: &[(&str, &str)] = if monolithic {
+    let settings: &[(&str, &str)] = if reuse_lu {
         &[("-ksp_type", "gmres"), ("-ksp_gmres_restart", "100"), ("-snes_lag_preconditioner", "3"), ("-snes_ksp_ew", "true")]
     } else {
         &[("-ksp_type", "preonly"), ("-snes_lag_preconditioner", "1"), ("-snes_ksp_ew", "false")]

@@ -299,6 +299,15 @@ impl EhlProblem for EhlSystem<'_> {
     fn take_collapse(&mut self) -> Option<[f64; 2]> {
         self.collapse.take()
     }
+    /// The tilt continuation on the monolithic coupling (as on the condensed one): the
+    /// element velocities at the vertices are re-evaluated from the new field.
+    fn set_velocity(&mut self, velocity: Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync>) -> bool {
+        for e in &mut self.elements {
+            e.vel = e.verts.map(|v| velocity(v[0], v[1]));
+        }
+        self.params.velocity = velocity;
+        true
+    }
 
     fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64) {
         self.params.set_operating(lambda_bar, penalty);
