@@ -598,8 +598,9 @@ choice_enum! {
         /// compliance); Newton on (P, H0) with a dense LU: fastest on small meshes, but
         /// its cost grows as the cube of the pressure unknowns.
         Condensed = "condensed",
-        /// U, P and H0 in one sparse matrix, factorised by MUMPS every third Newton step
-        /// (GMRES on the last factorisation in between).
+        /// U, P and H0 in one sparse matrix, factorised by MUMPS at every Newton step from
+        /// the Hertz start, every third step (GMRES on the last factorisation in between)
+        /// from a start near the solution.
         Monolithic = "monolithic",
     } default = Auto
 }

@@ -110,8 +110,9 @@ struct Policy {
     /// on the monolithic coupling and from a start near the solution (another mesh's
     /// pressure, a previous operating point): from the Hertz start the inexact steps cost
     /// the hard scenes their convergence (spin-0.33deg: plain Newton ran out of its 30
-    /// iterations at residual 5e-4, where exact Newton converges in 24, and the tilt
-    /// continuation is not available on the monolithic coupling).
+    /// iterations at residual 5e-4, where exact Newton converges in 24, and every
+    /// continuation after it failed; that run predates the tilt continuation on the
+    /// monolithic coupling).
     reuses_lu: bool,
 }
 
@@ -535,7 +536,6 @@ fn rigid_start(ctx: &Context, system: &mut CondensedSystem, x0: &mut [f64], (lo,
 
 /// The monolithic path: U, P and H0 in one sparse system, from the Hertz start or from a
 /// previous state `start` (same layout).
-#[allow(clippy::too_many_arguments)]
 #[allow(clippy::too_many_arguments)]
 fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool, start: Start, reuse_lu: bool) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
