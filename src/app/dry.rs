@@ -40,6 +40,7 @@ pub fn mesh_spec(scene: &Scene, half_z: bool) -> mesh::MeshSpec {
             (mesh::Rect { x0: m.patch_x_min, x1: m.patch_x_max, z0: m.patch_z_min, z1: m.patch_z_max }, m.patch_size)
         }),
         patch_radii: (scene.mesh.patch_size > 0.0 && scene.mesh.patch_r_max > 0.0).then_some((scene.mesh.patch_r_min, scene.mesh.patch_r_max)),
+        size_field: None,
     }
 }
 

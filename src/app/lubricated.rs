@@ -28,6 +28,12 @@ pub struct Setup {
 
 impl Setup {
     pub fn new(ctx: &Context, scene: &Scene) -> Result<Setup, String> {
+        Self::with_size_field(ctx, scene, None)
+    }
+
+    /// As [`Setup::new`], the contact face refined to `field` as well (adaptive
+    /// refinement; elastic solids only).
+    pub fn with_size_field(ctx: &Context, scene: &Scene, field: Option<std::sync::Arc<crate::mesh::size_field::SizeField>>) -> Result<Setup, String> {
         let t0 = Instant::now();
         let half = scene.uses_half_domain();
         if half {
@@ -40,7 +46,9 @@ impl Setup {
             let p = mesh::face::face_partition(&m, ctx.size);
             (m, p)
         } else {
-            let m = super::dry::build_mesh(scene, half)?;
+            let mut spec = super::dry::mesh_spec(scene, half);
+            spec.size_field = field;
+            let m = mesh::generate(&spec).map_err(|e| format!("mesh: {e}"))?;
             let p = mesh::partition(&m, ctx.size);
             (m, p)
         };
@@ -122,6 +130,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     if let Some(zc) = scene.spin_pole_over_a() {
         let inside = if zc.abs() < 1.0 { ": inside the Hertz circle, so the lubricant circulates on closed streamlines in the contact (the hardest spin regime)" } else { "" };
         ctx.log(format!("spin: the mean surface velocity turns about (0, {zc:.3}a){inside}"));
+    }
+    if scene.accuracy.target > 0.0 {
+        return super::adapt::run(ctx, scene, earlier);
     }
     let setup = Setup::new(ctx, scene)?;
     let report = effects_report(scene, setup.half);

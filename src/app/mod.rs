@@ -1,5 +1,6 @@
 //! The program: reads the scene, starts PETSc, runs the simulation the scene asks for and
 //! writes the results. `main.rs` only parses the command line and calls [`run`].
+pub mod adapt;
 pub mod collective;
 pub mod dry;
 pub mod lubricated;

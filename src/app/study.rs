@@ -91,6 +91,8 @@ pub fn check_ladder(ladder: Ladder, first: f64, levels: usize) -> Result<(), Str
 /// The scene with the mesh of level size `h`.
 pub fn level_scene(scene: &Scene, ladder: Ladder, h: f64) -> Scene {
     let mut s = scene.clone();
+    // A study's levels are its meshes: no adaptive refinement inside a level.
+    s.accuracy.target = 0.0;
     if ladder == Ladder::Ring {
         s.mesh.ring_size = h;
         return s;

@@ -75,8 +75,18 @@ pub fn parse_scene_with(text: &str, default_name: &str, overrides: &[String]) ->
         apply_override(&mut table, o)?;
     }
     spec::check_table(SCENE_FIELDS, &table, SCENE_FIELDS, "")?;
+    let hand_mesh = table.contains_key("mesh");
     let mut scene = Scene::deserialize(toml::Value::Table(table))
         .map_err(|e| SceneErrorKind::Syntax(format!("scene does not match the schema: {e}")))?;
+    if scene.accuracy.target < 0.0 {
+        // Not given: a lubricated, elastic, single-point scene whose mesh nobody made by
+        // hand is refined to the default target.
+        let adaptive = !hand_mesh
+            && scene.effects.lubrication == LubricationModel::Reynolds
+            && scene.effects.elasticity == ElasticityModel::Elastic
+            && scene.sweep.is_none();
+        scene.accuracy.target = if adaptive { schema::DEFAULT_ACCURACY_TARGET } else { 0.0 };
+    }
     if scene.name.is_empty() {
         if default_name.trim().is_empty() {
             return Err(SceneErrorKind::MissingField {
@@ -244,6 +254,20 @@ impl Scene {
             }
             if self.operating.entrainment_speed.is_none() {
                 return Err(missing("operating.entrainment_speed"));
+            }
+        }
+        if self.accuracy.target > 0.0 {
+            let why = if e.lubrication != LubricationModel::Reynolds {
+                Some("a dry scene has no film to refine for")
+            } else if e.elasticity != ElasticityModel::Elastic {
+                Some("adaptive refinement needs the elastic solid (effects.elasticity = \"elastic\")")
+            } else if self.sweep.is_some() {
+                Some("a sweep solves every point on one mesh: give [mesh] instead")
+            } else {
+                None
+            };
+            if let Some(why) = why {
+                return Err(SceneErrorKind::Conflict(format!("accuracy.target = {} is not supported here: {why} (remove accuracy.target or set it to 0)", self.accuracy.target)).into());
             }
         }
         if let Some(sw) = &self.sweep {

@@ -96,6 +96,9 @@ pub struct Scene {
     /// combination.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sweep: Option<Sweep>,
+    /// Accuracy target and adaptive refinement.
+    #[serde(default)]
+    pub accuracy: Accuracy,
 }
 
 /// Keys of the top level of the scene file.
@@ -169,6 +172,69 @@ pub const SCENE_FIELDS: &[Field] = &[
         "",
         Kind::Table(SWEEP_FIELDS),
         Presence::Default("none (one operating point)")
+    ),
+    f!(
+        "accuracy",
+        "accuracy target: adaptive refinement of the contact face until the estimated errors are below it",
+        "",
+        Kind::Table(ACCURACY_FIELDS),
+        Presence::Default("target 0.01 for a lubricated scene without [mesh]; none otherwise")
+    ),
+];
+
+// ---------------------------------------------------------------------------------------
+// [accuracy]
+
+/// Default relative error target of a lubricated scene without `[mesh]` keys.
+pub const DEFAULT_ACCURACY_TARGET: f64 = 0.01;
+
+/// `[accuracy]`: what a lubricated solve must reach, by adaptive refinement.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Accuracy {
+    /// Relative error target of hc and hm (and fx, fz when friction is on): the contact
+    /// face is refined where the error indicator is largest until the estimated error of
+    /// each is below it. 0: no refinement (the mesh of `[mesh]`). When absent: 0.01 for a
+    /// lubricated elastic single-point scene without `[mesh]` keys, else 0 (filled in by
+    /// the parser).
+    pub target: f64,
+    /// Most refinement levels after the first solve; default 8.
+    pub max_levels: u32,
+    /// Fraction theta of the total indicator that the marked elements carry (Doerfler
+    /// marking); default 0.5.
+    pub marking: f64,
+}
+
+impl Default for Accuracy {
+    fn default() -> Self {
+        // target < 0: not given (the parser fills it in).
+        Accuracy { target: -1.0, max_levels: 8, marking: 0.5 }
+    }
+}
+
+/// Keys of `[accuracy]`.
+pub const ACCURACY_FIELDS: &[Field] = &[
+    f!(
+        "target",
+        "relative error target of hc and hm (and fx, fz with friction); 0: no refinement, the [mesh] as given",
+        "",
+        Kind::Number(Range::Closed(0.0, 0.2)),
+        Presence::Default("0.01 for a lubricated elastic single-point scene without [mesh]; 0 otherwise"),
+        note = "refinement stops when the estimated relative error of every target quantity is below it; the estimate is the change between the last two levels (see docs/accuracy.md)"
+    ),
+    f!(
+        "max_levels",
+        "most refinement levels after the first solve",
+        "",
+        Kind::Number(Range::Closed(1.0, 12.0)),
+        Presence::Default("8")
+    ),
+    f!(
+        "marking",
+        "fraction of the total error indicator carried by the marked elements (Doerfler marking)",
+        "",
+        Kind::Number(Range::Closed(0.1, 0.9)),
+        Presence::Default("0.5")
     ),
 ];
 

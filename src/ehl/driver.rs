@@ -172,7 +172,7 @@ fn elastic_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &
 const START_PREFIX: &str = "start_";
 
 /// The scene's dimensionless entrainment velocity (Um, Wm)/Ue as a function of (X, Z).
-fn velocity_field(scene: &Scene) -> Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync> {
+pub fn velocity_field(scene: &Scene) -> Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync> {
     let kin = scene.kinematics().expect("lubricated scene");
     let (a, ue) = (scene.scales().a, scene.operating.entrainment_speed.unwrap());
     Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue])
@@ -212,14 +212,11 @@ fn stabilisation(scene: &Scene, penalty: f64) -> crate::reynolds::element::Stabi
         id: scene.reynolds.artificial_diffusion,
         cd: scene.reynolds.crosswind_diffusion,
         penalty,
-        // An incompressible lubricant has no film Peclet number (d rho/dP = 0: the
-        // pressure is not advected, the element falls back to |v|); with that larger tau
-        // the diffusive part of the strong residual stalls Newton (measured on
-        // cases/examples/barus-newtonian.toml), so "supg" keeps the Couette residual there.
+        // Every lubricant law gets the same consistent residual; an incompressible one
+        // takes its Peclet number from the elastic film response (see `supg_tau`).
         residual: match choice {
             S::SupgExact => StrongResidual::Full,
             S::SupgCouette => StrongResidual::Couette,
-            _ if scene.effects.density == crate::case::DensityModel::Incompressible => StrongResidual::Couette,
             _ => StrongResidual::FrozenLubricant,
         },
         film_peclet: true,

@@ -22,6 +22,7 @@ mod locate;
 mod partition;
 mod quality;
 mod refine;
+pub mod size_field;
 pub mod spec;
 pub mod face;
 
@@ -107,6 +108,10 @@ fn refined_bisector(spec: &MeshSpec, h: f64) -> refine::Bisector {
         }
         if let Some((r0, r1, hr)) = ring {
             target = target.min(hr + g * refine::ring_distance(v, t, r0, r1));
+        }
+        if let Some(f) = &spec.size_field {
+            let [(x0, x1), (_, y1), (z0, z1)] = refine::tet_ranges(v, t);
+            target = target.min(f.min_over([x0, z0], [x1, z1]) + g * (-y1).max(0.0));
         }
         refine::longest_edge(v, t) > 3f64.sqrt() * target * (1.0 + 1e-10)
     });

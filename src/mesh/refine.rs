@@ -213,7 +213,7 @@ pub(crate) fn bbox_distance(v: &[[f64; 3]], t: &[u32; 4], lo: &[f64; 3], hi: &[f
 }
 
 /// Coordinate ranges `(min, max)` of tet `t` along x, y and z (its bounding box).
-fn tet_ranges(v: &[[f64; 3]], t: &[u32; 4]) -> [(f64, f64); 3] {
+pub(crate) fn tet_ranges(v: &[[f64; 3]], t: &[u32; 4]) -> [(f64, f64); 3] {
     std::array::from_fn(|c| t.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| (lo.min(v[i as usize][c]), hi.max(v[i as usize][c]))))
 }
 

@@ -81,6 +81,10 @@ pub struct MeshSpec {
     /// with `r_min <= sqrt(X^2 + Z^2) <= r_max` is refined (a sector of an annulus, for a
     /// side lobe that follows the contact edge).
     pub patch_radii: Option<(f64, f64)>,
+    /// Optional graded size field on the top face (adaptive refinement: sizes from an
+    /// error estimate on an earlier mesh); the tetrahedra under it are refined to it plus
+    /// `growth` times their depth.
+    pub size_field: Option<std::sync::Arc<super::size_field::SizeField>>,
 }
 
 /// An annulus on the top face, centred on the origin, with its element size.
@@ -110,6 +114,7 @@ impl MeshSpec {
             ring: None,
             patch: None,
             patch_radii: None,
+            size_field: None,
         }
     }
 

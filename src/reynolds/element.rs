@@ -166,13 +166,26 @@ pub fn streamline_length_from_gradients(g: &[[f64; 2]; 3], v: [f64; 2]) -> f64 {
     2.0 * vn / s
 }
 
+/// Film response dH/dP of the elastic solid to a pressure mode of wavelength h_e, over
+/// h_e, in the dimensionless units of the Reynolds equation (H = h R/a^2, P = p/p_H): a
+/// pressure p over a patch of size s deflects a half-space by about 2 p s/(pi E'), which is
+/// 2 s P/pi^2 in these units.
+pub const ELASTIC_FILM_RESPONSE: f64 = 2.0 / (std::f64::consts::PI * std::f64::consts::PI);
+
 /// SUPG parameter tau = delta h_e / (2|v|) xi(Pe) at a quadrature point (|v| = `vn` > 0),
-/// with Pe = |v| h_e / (2 eps), times (d rho_bar/dP) H when `stab.film_peclet` (Habchi's
-/// beta; an incompressible lubricant, drho = 0, keeps |v|). Shared by the P2 and P1
-/// elements; exact through the duals.
+/// with Pe = |beta| h_e / (2 eps) on the convection velocity beta of P in the Couette term
+/// when `stab.film_peclet`, else on |v|. beta = (d rho_bar/dP) H v for a compressible
+/// lubricant (Habchi's); an incompressible one (drho = 0) convects P only through the
+/// elastic film, beta = [`ELASTIC_FILM_RESPONSE`] h_e v. Any tau keeps SUPG consistent (it
+/// multiplies the strong residual); this one sets how strongly it acts. Shared by the P2
+/// and P1 elements; exact through the duals.
 pub fn supg_tau<const N: usize>(stab: &Stabilisation, vn: f64, h_e: f64, eps: Dual<N>, drho: Dual<N>, h: Dual<N>) -> Dual<N> {
     let pe_v = (vn * h_e * 0.5) / eps;
-    let pe = if stab.film_peclet && drho.v != 0.0 { pe_v * drho * h } else { pe_v };
+    let pe = match (stab.film_peclet, drho.v != 0.0) {
+        (true, true) => pe_v * drho * h,
+        (true, false) => pe_v * (ELASTIC_FILM_RESPONSE * h_e),
+        (false, _) => pe_v,
+    };
     let (xv, dxv) = xi(pe.v);
     pe.chain(xv, dxv) * (stab.delta * h_e / (2.0 * vn))
 }

@@ -89,6 +89,7 @@
 pub mod cavitation;
 pub mod dual;
 pub mod element;
+pub mod estimate;
 pub mod p1;
 pub mod p2;
 pub mod quadrature;

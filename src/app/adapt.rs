@@ -1,0 +1,288 @@
+//! Adaptive refinement to an accuracy target (`[accuracy] target`).
+//!
+//! 1. Solve on the scene's mesh (level 0).
+//! 2. Indicate: every contact triangle gets the mass flux its discrete solution fails to
+//!    balance ([`crate::reynolds::estimate`]).
+//! 3. Mark the fewest triangles carrying a fraction `accuracy.marking` of the total
+//!    (Doerfler), halve their size, keep the others' (a graded size field on the face,
+//!    [`crate::mesh::size_field`]), and mesh the solid anew under it (conforming bisection).
+//! 4. Solve from the previous level's pressure, interpolated (mesh sequencing).
+//! 5. Estimate the error of hc and hm (and fx, fz with friction) from the change between
+//!    the last two levels, e_k = |Q_k - Q_{k-1}| max(1, rho/(1 - rho)) with rho the observed
+//!    ratio of the last two changes (capped at 0.8): for a sequence converging by a factor
+//!    rho per level the remaining error is rho/(1 - rho) times the last change. Stop when
+//!    every estimate is below the target (from level 2 on, so that rho is measured), or
+//!    fail honestly after `accuracy.max_levels`.
+use super::lubricated::{post_point, Setup};
+use super::{collective, Context};
+use crate::case::Scene;
+use crate::ehl::driver::{self, EhlSolution, EhlSolver, Start};
+use crate::ehl::post::FieldsOnFace;
+use crate::mesh::size_field::SizeField;
+use crate::mesh::spec::dyadic_size;
+use crate::reynolds::estimate::{dorfler_mark, element_residual};
+use serde_json::json;
+use std::collections::HashMap;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Smallest element size adaptive refinement makes (units of a): 16/2^12.
+pub const MIN_ADAPTIVE_SIZE: f64 = 16.0 / 4096.0;
+
+/// The ratio of successive changes is capped here: beyond it the sequence is not
+/// converging in a way an estimate can trust, and the factor rho/(1 - rho) stays at 4.
+const RHO_CAP: f64 = 0.8;
+
+/// One level of the adaptive loop.
+#[derive(Debug, Clone)]
+pub struct Level {
+    pub elastic_unknowns: usize,
+    pub pressure_unknowns: usize,
+    pub contact_triangles: usize,
+    pub min_size: f64,
+    pub newton_iterations: usize,
+    pub seconds: f64,
+    /// hc, hm (m), pmax (Pa).
+    pub hc: f64,
+    pub hm: f64,
+    pub pmax: f64,
+    /// Estimated relative errors of hc and hm (None on level 0).
+    pub est: Option<[f64; 2]>,
+}
+
+/// The estimated relative error of the last value of `q` (see the module documentation).
+pub fn estimate(q: &[f64]) -> Option<f64> {
+    let n = q.len();
+    if n < 2 {
+        return None;
+    }
+    let d1 = (q[n - 1] - q[n - 2]).abs();
+    let factor = if n >= 3 {
+        let d0 = (q[n - 2] - q[n - 3]).abs();
+        let rho = if d0 > 0.0 { (d1 / d0).min(RHO_CAP) } else { RHO_CAP };
+        (rho / (1.0 - rho)).max(1.0)
+    } else {
+        1.0
+    };
+    Some(factor * d1 / q[n - 1].abs())
+}
+
+/// The indicator of every contact triangle of a converged level (on every rank: each holds
+/// the whole iterate).
+fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
+    let mesh = fields.mesh;
+    let lub = driver::lubricant(scene);
+    let fluid = lub.fluid(driver::lambda_bar(scene));
+    let vel = driver::velocity_field(scene);
+    let penalty = if scene.effects.cavitation == crate::case::CavitationModel::Penalty { scene.reynolds.penalty } else { 0.0 };
+    let n = mesh.contact_tris.len();
+    let mut eta = vec![0.0; n];
+    // Edge (low, high vertex id) -> outward fluxes at its Gauss points, ordered from the
+    // low to the high vertex, summed over the two triangles that share it.
+    let mut jumps: HashMap<(u32, u32), ([f64; 2], [usize; 2], u8)> = HashMap::new();
+    for (k, tri) in mesh.contact_tris.iter().enumerate() {
+        let verts = [0, 1, 2].map(|i| {
+            let c = mesh.nodes[tri[i] as usize];
+            [c[0], c[2]]
+        });
+        let p = tri.map(|n| fields.p_node(n));
+        let h = tri.map(|n| fields.h_node(n));
+        let v = verts.map(|x| vel(x[0], x[1]));
+        let r = element_residual(&verts, &p, &h, &v, &fluid, penalty);
+        eta[k] = r.interior;
+        for e in 0..3 {
+            let (a, b) = (tri[e], tri[(e + 1) % 3]);
+            let f = if a < b { r.edge_flux[e] } else { [r.edge_flux[e][1], r.edge_flux[e][0]] };
+            let entry = jumps.entry((a.min(b), a.max(b))).or_insert(([0.0; 2], [k, k], 0));
+            entry.0[0] += f[0];
+            entry.0[1] += f[1];
+            entry.1[entry.2 as usize % 2] = k;
+            entry.2 += 1;
+        }
+    }
+    for (sum, owners, count) in jumps.values() {
+        // Boundary edges (one owner) carry the Dirichlet condition: no jump.
+        if *count == 2 {
+            let j = sum[0].abs() + sum[1].abs();
+            eta[owners[0]] += 0.5 * j;
+            eta[owners[1]] += 0.5 * j;
+        }
+    }
+    eta
+}
+
+/// Length of the longest edge of contact triangle `k` (units of a).
+fn longest_edge(fields: &FieldsOnFace, k: usize) -> f64 {
+    let tri = fields.mesh.contact_tris[k];
+    let p = [0, 1, 2].map(|i| fields.mesh.nodes[tri[i] as usize]);
+    (0..3).map(|e| (p[e][0] - p[(e + 1) % 3][0]).hypot(p[e][2] - p[(e + 1) % 3][2])).fold(0.0, f64::max)
+}
+
+/// The size field of the next level: marked triangles at half their size, the others at
+/// theirs (a triangle of a Kuhn cell of size h has its longest edge h sqrt 2, or h one
+/// bisection further; both halve to h/2 and keep h).
+fn next_field(fields: &FieldsOnFace, marked: &[bool], growth: f64) -> SizeField {
+    let mesh = fields.mesh;
+    let sizes: Vec<f64> = (0..mesh.contact_tris.len())
+        .map(|k| {
+            let e = longest_edge(fields, k);
+            if marked[k] {
+                dyadic_size(0.5 * e).max(MIN_ADAPTIVE_SIZE)
+            } else {
+                dyadic_size(e)
+            }
+        })
+        .collect();
+    let smallest = sizes.iter().cloned().fold(f64::INFINITY, f64::min);
+    let mut f = SizeField::new(mesh.spec.contact, 0.5 * smallest, growth, mesh.spec.contact_size);
+    for (k, tri) in mesh.contact_tris.iter().enumerate() {
+        let v = [0, 1, 2].map(|i| {
+            let c = mesh.nodes[tri[i] as usize];
+            [c[0], c[2]]
+        });
+        f.impose_triangle(&v, sizes[k]);
+    }
+    f.grade();
+    f
+}
+
+/// Runs the adaptive loop of a lubricated single-point scene with `accuracy.target > 0`.
+/// Collective.
+pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<(), String> {
+    let target = scene.accuracy.target;
+    let max_levels = scene.accuracy.max_levels as usize;
+    ctx.log(format!(
+        "accuracy: target {target} (relative error of hc and hm): adaptive refinement of the contact face, at most {max_levels} levels after the first"
+    ));
+    let mut levels: Vec<Level> = Vec::new();
+    let mut field: Option<Arc<SizeField>> = None;
+    let mut previous: Option<(Setup, EhlSolution)> = None;
+    let growth = scene.mesh.growth;
+    for k in 0..=max_levels {
+        let t0 = Instant::now();
+        let setup = Setup::with_size_field(ctx, scene, field.clone())?;
+        let solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
+        let sol = match (&previous, earlier) {
+            (Some((ps, psol)), _) => {
+                let pf = FieldsOnFace::new(&ps.mesh, &ps.layout, &psol.x);
+                let hc = pf.stats().hc;
+                let p = |x: f64, z: f64| pf.at(x, z).map_or(0.0, |v| v.0);
+                let label = format!("level {}'s pressure ({} contact triangles)", k - 1, ps.mesh.contact_tris.len());
+                solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc, label: &label })?
+            }
+            (None, Some(e)) => e.solve(ctx, scene, &solver)?,
+            (None, None) => solver.solve(ctx, scene, None)?,
+        };
+        let fields = FieldsOnFace::new(&setup.mesh, &setup.layout, &sol.x);
+        let st = fields.stats();
+        if ![st.hc, st.hm, st.pmax].iter().all(|v| v.is_finite()) || st.hm <= 0.0 {
+            return Err(format!("accuracy: level {k} converged to an unphysical state (hc {}, hm {}); no result written", st.hc, st.hm));
+        }
+        let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
+        let (n_u, n_p) = setup.layout.counts();
+        let min_size = (0..setup.mesh.contact_tris.len()).map(|t| longest_edge(&fields, t)).fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
+        let mut level = Level {
+            elastic_unknowns: n_u,
+            pressure_unknowns: n_p,
+            contact_triangles: setup.mesh.contact_tris.len(),
+            min_size,
+            newton_iterations: sol.newton_total,
+            seconds: t0.elapsed().as_secs_f64(),
+            hc: st.hc * hs,
+            hm: st.hm * hs,
+            pmax: st.pmax * ph,
+            est: None,
+        };
+        let hcs: Vec<f64> = levels.iter().map(|l| l.hc).chain([level.hc]).collect();
+        let hms: Vec<f64> = levels.iter().map(|l| l.hm).chain([level.hm]).collect();
+        if let (Some(ec), Some(em)) = (estimate(&hcs), estimate(&hms)) {
+            level.est = Some([ec, em]);
+        }
+        ctx.log(format!(
+            "accuracy: level {k}: {} contact triangles (smallest {:.4} a), {} unknowns, {} Newton its, {:.1} s: hc = {:.5e} m, hm = {:.5e} m, pmax = {:.4e} Pa; estimated error {}",
+            level.contact_triangles,
+            level.min_size,
+            n_u + n_p + 1,
+            level.newton_iterations,
+            level.seconds,
+            level.hc,
+            level.hm,
+            level.pmax,
+            level.est.map_or("- (first level)".to_string(), |e| format!("hc {:.2} %, hm {:.2} %", 100.0 * e[0], 100.0 * e[1]))
+        ));
+        let reached = k >= 2 && level.est.is_some_and(|e| e.iter().all(|&v| v < target));
+        levels.push(level);
+        if reached || k == max_levels {
+            if !reached {
+                return Err(format!(
+                    "accuracy: target {target} not reached after {max_levels} refinement levels (estimated error hc {:.2} %, hm {:.2} %); raise accuracy.max_levels or the target",
+                    100.0 * levels[k].est.map_or(f64::NAN, |e| e[0]),
+                    100.0 * levels[k].est.map_or(f64::NAN, |e| e[1])
+                ));
+            }
+            ctx.log(format!("accuracy: target {target} reached at level {k}"));
+            let r = post_point(ctx, scene, &setup, &sol, solver.condensation_s, &ctx.out_dir);
+            collective::agree(&ctx.world, r)?;
+            if ctx.rank == 0 {
+                add_accuracy_to_summary(ctx, target, &levels)?;
+            }
+            return Ok(());
+        }
+        let eta = indicators(scene, &fields);
+        let eligible: Vec<bool> = (0..eta.len()).map(|t| longest_edge(&fields, t) > 1.5 * MIN_ADAPTIVE_SIZE).collect();
+        let marked = dorfler_mark(&eta, &eligible, scene.accuracy.marking);
+        if !marked.iter().any(|&m| m) {
+            return Err(format!("accuracy: target {target} not reached: every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"));
+        }
+        field = Some(Arc::new(next_field(&fields, &marked, growth)));
+        drop(solver);
+        previous = Some((setup, sol));
+        crate::interrupt::check("adaptive refinement")?;
+    }
+    unreachable!("the loop returns at max_levels")
+}
+
+/// Adds `accuracy` (target, estimates, levels) to the summary.json that post_point wrote.
+fn add_accuracy_to_summary(ctx: &Context, target: f64, levels: &[Level]) -> Result<(), String> {
+    let path = ctx.out_dir.join("summary.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let mut summary: serde_json::Value = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let last = levels.last().expect("a level");
+    let est = last.est.unwrap_or([f64::NAN; 2]);
+    summary["accuracy"] = json!({
+        "target": target,
+        "reached": est.iter().all(|&e| e < target),
+        "estimated_error": { "hc": est[0], "hm": est[1] },
+        "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8)",
+        "levels": levels.iter().enumerate().map(|(k, l)| json!({
+            "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
+            "contact_triangles": l.contact_triangles, "smallest_size_a": l.min_size,
+            "newton_iterations": l.newton_iterations, "seconds": l.seconds,
+            "hc_m": l.hc, "hm_m": l.hm, "pmax_pa": l.pmax,
+            "estimated_error": l.est.map(|e| json!({ "hc": e[0], "hm": e[1] })),
+        })).collect::<Vec<_>>(),
+    });
+    ctx.write_summary_to(&ctx.out_dir, &summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_estimate_of_a_geometric_sequence_bounds_its_error() {
+        // q_k = 1 + 0.1 rho^k converges to 1; the estimate of the last value's relative
+        // error is rho/(1-rho) times the last change: exact for a geometric sequence.
+        for rho in [0.25, 0.5, 0.7] {
+            let q: Vec<f64> = (0..5).map(|k| 1.0 + 0.1 * f64::powi(rho, k)).collect();
+            let e = estimate(&q).unwrap();
+            let true_err = (q[4] - 1.0) / q[4];
+            let factor = (rho / (1.0 - rho)).max(1.0);
+            assert!((e - factor * (q[4] - q[3]).abs() / q[4]).abs() < 1e-15);
+            assert!(e >= true_err * (1.0 - 1e-12), "rho {rho}: estimate {e} below the error {true_err}");
+        }
+        assert_eq!(estimate(&[1.0]), None);
+        // Two values: the change itself.
+        assert!((estimate(&[1.0, 1.01]).unwrap() - 0.01 / 1.01).abs() < 1e-15);
+    }
+}
