@@ -426,7 +426,7 @@ impl Scene {
         )
     }
 
-    /// Material of the equivalent elastic solid (physics.md section 6).
+    /// Material of the equivalent elastic solid (docs/model.md section 6).
     pub fn equivalent_solid(&self) -> Material {
         equivalent_solid(self.ball_material(), self.disc_material())
     }
