@@ -145,9 +145,12 @@ const REFERENCE_PREAMBLE: &str = "\
 
 A scene is a TOML file with the sections below. Every key is checked before anything is
 solved: an unknown key (with the closest known key suggested), a missing required key, a
-wrong type, a number out of range or a contradiction between keys stops the run with exit
-code 2 and a message naming the key. `--set KEY=VALUE` on the command line overrides a key
-before that check (`--set operating.load=2000`, `--set effects.friction=none`).
+wrong type, a number out of range or a contradiction between keys (a Roelands exponent with
+Barus viscosity, a swept tilt angle with uniform kinematics, ...) stops the run with exit
+code 2 and a message naming the key. Keys that are valid but have no effect (a tilt angle
+with uniform kinematics, friction without lubrication or without sliding) print a warning
+at the start of the run. `--set KEY=VALUE` on the command line overrides a key before the
+check (`--set operating.load=2000`, `--set effects.friction=none`).
 
 Units are SI except where the unit column says `a`: lengths in units of the Hertz radius
 a = (3 L R_B / (2 E'))^(1/3), which the program computes from the scene (0.92 mm for the
