@@ -20,7 +20,7 @@ fn dry_hertz_matches_half_space_and_is_rank_invariant() {
     let s1 = run_dry(1);
     let s2 = run_dry(2);
     let (a, ph) = (num(&s2, "hertz.a_m"), num(&s2, "hertz.ph_pa"));
-    // Table 1 / physics.md: a = 0.92052 mm, p_H = 0.84522 GPa.
+    // Table 1 / docs/model.md section 2: a = 0.92052 mm, p_H = 0.84522 GPa.
     assert!((a / 0.92052e-3 - 1.0).abs() < 2e-4, "a = {a}");
     assert!((ph / 0.84522e9 - 1.0).abs() < 2e-4, "p_H = {ph}");
     let r = 0.08;

@@ -51,8 +51,8 @@ fn half_domain_matches_full_domain_with_half_the_unknowns() {
 ///   h_min = R Hhat (eta0 u R / w)^2,  Hhat = 128 k phi^2 (0.131 atan(k/2) + 1.683)^2,
 ///   phi = (1 + 2/(3k))^-1, k = 1 for a circular contact (Hhat = 140.1).
 /// The IR film depends on how far upstream the inlet is (the pressure tail decays only
-/// like 1/r^3): our inlet-length study (README "Isoviscous-rigid check") gives -33 % at
-/// the inlet used here (12a = 9 sqrt(2 R h) upstream), -20 % at 28a, and about -11 %
+/// like 1/r^3): our inlet-length study (docs/validation.md "Isoviscous, rigid contact")
+/// gives -33 % at the inlet used here (12a = 9 sqrt(2 R h) upstream), -20 % at 28a, and about -11 %
 /// extrapolated to an infinite inlet; the mesh error is 0.2 %. The test pins the film in
 /// [-40 %, 0] of the formula: a broken Couette, Poiseuille, load or penalty term moves it far
 /// outside (a factor 2 in eta moves h by 4).

@@ -2,7 +2,7 @@
 //! under 2 MPI ranks: the load balance
 //! closes, and every output the user looks at is written: summary.json, the two profile
 //! CSVs, the PNG maps and profiles, the contact-face VTU.
-//! This checks the pipeline, not the film values (see README "Lubricated solver: state").
+//! This checks the pipeline, not the film values (see docs/validation.md).
 mod common;
 use common::*;
 

@@ -50,7 +50,8 @@ fn convergence_study_writes_its_table_and_plots() {
 /// then 4,824 pressure unknowns: condensed, then monolithic) in one process, each level
 /// from the previous one's pressure (`--sequence`). The condensed level's solver defaults
 /// (ScaLAPACK) must not leak into the monolithic level, and both films must match the
-/// runs of the same meshes from the Hertz start (README.md's narrow-ring ladder, 2 ranks).
+/// runs of the same meshes from the Hertz start (docs/performance.md's narrow-ring ladder,
+/// 2 ranks).
 #[test]
 fn sequenced_ring_ladder_switches_coupling() {
     let dir = scratch("study-sequence");
@@ -64,7 +65,7 @@ fn sequenced_ring_ladder_switches_coupling() {
     assert!(t.contains("Newton from the pressure of"), "{t}");
     let md = std::fs::read_to_string(out_dir.join("study.md")).unwrap();
     assert!(md.contains("--sequence"), "{md}");
-    // hc, hm of the two meshes from the Hertz start (README "hm on a narrow ring ladder":
+    // hc, hm of the two meshes from the Hertz start (docs/performance.md "Ladders":
     // 0.36427 / 0.13652 and 0.36301 / 0.13636 um): the same discrete problems, so they
     // agree to the 5 printed digits.
     for (level, hc, hm) in [(1, 0.36427e-6, 0.13652e-6), (2, 0.36301e-6, 0.13636e-6)] {

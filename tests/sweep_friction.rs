@@ -1,10 +1,10 @@
 //! Spin kinematics, the friction pass and sweeps end to end (2 MPI ranks, coarse mesh,
 //! light load so that it runs in seconds): a two-point tilt sweep at SRR = 5 %.
-//! Checks against numbers from outside the code: the kinematics of physics.md section 3
+//! Checks against numbers from outside the code: the kinematics of docs/model.md section 3
 //! by hand, the sign convention of section 7 (SRR > 0 drags the disc towards +x), and the
 //! paper's findings 4 and 5 (spin lowers fx; |fz| is far below fx). The friction values
 //! themselves are checked in the unit tests of the shear law (uniform-film and Newtonian
-//! limits) and, on the paper's mesh, by `paper-findings` (README "Paper figures").
+//! limits) and, on the paper's mesh, by `paper-findings` (docs/paper.md).
 mod common;
 use common::*;
 
@@ -31,7 +31,7 @@ fn tilt_sweep_with_friction() {
     assert_eq!(rows.len(), 2, "{table}");
     assert!(rows.iter().all(|r| r.contains(",converged,")), "{table}");
     let (s90, s2) = (summary(&out_dir.join("point_001")), summary(&out_dir.join("point_002")));
-    // Kinematics by hand (physics.md section 3): U_BO = Ue (1 + SRR/2) = 2.05 m/s,
+    // Kinematics by hand (docs/model.md section 3): U_BO = Ue (1 + SRR/2) = 2.05 m/s,
     // U_DO = 1.95 m/s, omega_B = U_BO / (R_B sin lambda), omega_D = U_DO / R_D.
     let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
     assert!(rel(num(&s90, "kinematics.U_BO_m_s"), 2.05) < 1e-12);

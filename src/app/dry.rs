@@ -1,6 +1,6 @@
 //! The dry Hertz scene: the Hertzian pressure applied as a traction on the contact face of
 //! the equivalent solid, one linear elastic solve, and the surface deflection compared with
-//! the half-space solution (physics.md sections 2 and 6).
+//! the half-space solution (docs/model.md sections 2 and 6).
 use super::{collective, Context};
 use crate::case::Scene;
 use crate::mesh::{self, Mesh};

@@ -1,4 +1,4 @@
-//! Prints the numbers behind each finding of the paper (physics.md section 8, items 1-6)
+//! Prints the numbers behind each finding of the paper (docs/paper.md, findings 1-6)
 //! from the outputs of the paper scenes, and whether the model reproduces it:
 //!
 //!   paper-findings [--fig4-6 DIR] [--fig7-8 DIR] [--case1 DIR] [--case2 DIR] [--extra DIR]...

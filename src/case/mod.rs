@@ -14,7 +14,7 @@
 //!    lubricant and entrainment speed present when lubricated, Roelands-only keys, etc.
 //!
 //! [`reference_markdown`] renders the schema (keys, meaning, unit, range, default) as
-//! Markdown for the README.
+//! Markdown: docs/scene-reference.md is its output (a test keeps the two equal).
 pub mod error;
 pub mod schema;
 pub mod spec;
@@ -140,11 +140,34 @@ fn syntax_message(text: &str, e: &toml::de::Error) -> String {
     }
 }
 
-/// The schema as Markdown tables (key, meaning, unit, allowed values, default), for the
-/// README reference.
+/// The scene-file reference, docs/scene-reference.md: a short preamble, then the schema as
+/// Markdown tables (key, meaning, unit, allowed values, default), one per section.
 pub fn reference_markdown() -> String {
-    spec::reference_markdown(SCENE_FIELDS)
+    format!("{REFERENCE_PREAMBLE}{}", spec::reference_markdown(SCENE_FIELDS))
 }
+
+const REFERENCE_PREAMBLE: &str = "\
+# Scene file reference
+
+<!-- Generated from src/case/schema.rs by `ehl-petsc --scene-reference`; do not edit.
+     tests/scene_reference.rs keeps this file equal to the generated text. Regenerate with
+     target/release/ehl-petsc --scene-reference > docs/scene-reference.md -->
+
+A scene is a TOML file with the sections below. Every key is checked before anything is
+solved: an unknown key (with the closest known key suggested), a missing required key, a
+wrong type, a number out of range or a contradiction between keys (a Roelands exponent with
+Barus viscosity, a swept tilt angle with uniform kinematics, ...) stops the run with exit
+code 2 and a message naming the key. Keys that are valid but have no effect (a tilt angle
+with uniform kinematics, friction without lubrication or without sliding) print a warning
+at the start of the run. `--set KEY=VALUE` on the command line overrides a key before the
+check (`--set operating.load=2000`, `--set effects.friction=none`).
+
+Units are SI except where the unit column says `a`: lengths in units of the Hertz radius
+a = (3 L R_B / (2 E'))^(1/3), which the program computes from the scene (0.92 mm for the
+paper's Table 1). `cases/examples/minimal.toml` shows the smallest lubricated scene: every
+key it leaves out takes the default below, and the defaults are the paper's model.
+
+";
 
 fn missing(path: &str) -> SceneError {
     let f = spec::lookup(SCENE_FIELDS, path).expect("schema path");
@@ -430,7 +453,7 @@ impl Scene {
         )
     }
 
-    /// Material of the equivalent elastic solid (physics.md section 6).
+    /// Material of the equivalent elastic solid (docs/model.md section 6).
     pub fn equivalent_solid(&self) -> Material {
         equivalent_solid(self.ball_material(), self.disc_material())
     }

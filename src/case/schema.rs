@@ -405,7 +405,7 @@ fn default_tilt_angle() -> f64 {
     90.0
 }
 
-/// `[operating]`: load and kinematics (physics.md section 3).
+/// `[operating]`: load and kinematics (docs/model.md section 3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Operating {
@@ -513,7 +513,7 @@ choice_enum! {
 choice_enum! {
     /// `effects.kinematics`: surface velocities.
     pub enum KinematicsModel {
-        /// Rolling, sliding and spinning (physics.md section 3).
+        /// Rolling, sliding and spinning (docs/model.md section 3).
         Spin = "spin",
         /// Uniform surface velocities U_BO, U_DO, no spin.
         Uniform = "uniform",
@@ -672,7 +672,7 @@ choice_enum! {
 }
 
 /// `reynolds.coupling = "auto"` solves the monolithic system above this many pressure
-/// unknowns. Measured on table2-ue2 (2 ranks, README "Coupling"): at 3,220 pressure
+/// unknowns. Measured on table2-ue2 (2 ranks, docs/performance.md "Couplings"): at 3,220 pressure
 /// unknowns the condensed solve takes 14.0 s and the monolithic 17.8 s, at 4,824 they take
 /// 35.7 s and 29.2 s, at 11,040 337 s and 96.5 s.
 pub const AUTO_MONOLITHIC_ABOVE: usize = 4000;
@@ -716,7 +716,7 @@ pub struct ReynoldsDomain {
     /// u_bar| acting across the streamlines only. It removes the crosswind stripes of the
     /// SUPG film (one-node dips at the side lobes) and changes hc by under 0.1 % at
     /// delta_CD = 0.1 on table2-ue2, but it also smears the side lobes of a heavily loaded
-    /// contact (hm -9.5 % at 2 GPa), so the default is 0 (README "Crosswind diffusion").
+    /// contact (hm -9.5 % at 2 GPa), so the default is 0 (docs/numerics.md "Crosswind diffusion").
     pub crosswind_diffusion: f64,
     /// "auto" | "condensed" | "monolithic"; default "auto" (condensed up to 4,000 pressure
     /// unknowns, 8,000 in a sweep, monolithic above). The same discrete problem either way.

@@ -367,7 +367,8 @@ fn check_number(field: &Field, range: Range, value: &Value, path: &str) -> Resul
     Ok(())
 }
 
-/// A Markdown reference of the schema (one heading and table per section), for the README.
+/// A Markdown reference of the schema (one heading and table per section), the body of
+/// docs/scene-reference.md.
 pub fn reference_markdown(root: &'static [Field]) -> String {
     let mut out = String::new();
     write_section(&mut out, root, "", "scene name and sections", "");
@@ -386,7 +387,7 @@ fn write_section(
     } else {
         format!("[{prefix}]")
     };
-    out.push_str(&format!("### {title}\n\n{what}{presence}.\n\n"));
+    out.push_str(&format!("## {title}\n\n{what}{presence}.\n\n"));
     let leaves: Vec<&Field> = fields
         .iter()
         .filter(|f| !matches!(f.kind, Kind::Table(_)))
@@ -409,10 +410,12 @@ fn write_section(
             };
             let unit = if f.unit.is_empty() { "-" } else { f.unit };
             out.push_str(&format!(
-                "| `{}` | {}{note} | {unit} | {allowed} | {} |\n",
+                "| `{}` | {} | {} | {} | {} |\n",
                 f.key,
-                f.what,
-                presence_text(f.presence)
+                table_cell(&format!("{}{note}", f.what)),
+                table_cell(unit),
+                table_cell(&allowed),
+                table_cell(&presence_text(f.presence))
             ));
         }
         out.push('\n');
@@ -426,6 +429,11 @@ fn write_section(
             write_section(out, sub, &join(prefix, f.key), f.what, &presence);
         }
     }
+}
+
+/// Text for a Markdown table cell: a bare `|` (as in |X| <= w) would end the cell.
+fn table_cell(text: &str) -> String {
+    text.replace('|', "\\|")
 }
 
 fn presence_text(p: Presence) -> String {

@@ -303,7 +303,12 @@ fn reference_lists_every_key() {
     ] {
         assert!(md.contains(&format!("`{key}`")), "{key} missing from\n{md}");
     }
-    assert!(md.contains("### [materials.ball]") && md.contains("### [effects]"));
+    assert!(md.contains("## [materials.ball]") && md.contains("## [effects]"));
+    // Every table row has its five cells: a `|` inside a cell (|X| <= w) is escaped.
+    for row in md.lines().filter(|l| l.starts_with('|')) {
+        let bars = row.matches('|').count() - row.matches("\\|").count();
+        assert_eq!(bars, 6, "a table row without exactly five cells: {row}");
+    }
 }
 
 // ---- bad input, one class per test ----------------------------------------------------

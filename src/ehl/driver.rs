@@ -669,7 +669,7 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     // (each step flips nodes across the penalty's kink; 30 iterations wasted on table2-ue2
     // with the ring halved), while from the xi = 1e3 solution the cavitated set is already
     // right. Every other continuation runs at xi = 1e3 too, where Newton converges from the
-    // Hertz start on every mesh measured (README "The cavitation penalty and the finer ring").
+    // Hertz start on every mesh measured (docs/numerics.md "The cavitation penalty xi").
     // A pressure from another mesh is staged the same way, a previous state of the same mesh
     // (a sweep) goes straight to the scene's xi ([`Start::stages_penalty`]).
     let target = scene.operating.load;
@@ -965,19 +965,19 @@ struct Collapse {
 impl Collapse {
     /// If the film closed within 0.25 a of a spin pole inside the Hertz circle: why, in
     /// words. At the pole the mean surface velocity vanishes, so the isothermal Reynolds
-    /// equation has no entrainment there to carry a film (README "Strong spin").
+    /// equation has no entrainment there to carry a film (docs/hard-cases.md "Strong spin").
     fn at_pole(&self) -> Option<String> {
         let zc = self.pole?;
         let [x, z] = self.at;
         (zc.abs() < 1.0 && x.hypot(z - zc) <= 0.25).then(|| {
-            format!("the film closes at ({x:.3}, {z:.3})a, next to the spin pole (0, {zc:.3})a inside the Hertz circle, where the mean surface velocity vanishes: the isothermal Reynolds equation has no entrainment there to carry a film (README \"Strong spin\")")
+            format!("the film closes at ({x:.3}, {z:.3})a, next to the spin pole (0, {zc:.3})a inside the Hertz circle, where the mean surface velocity vanishes: the isothermal Reynolds equation has no entrainment there to carry a film (docs/hard-cases.md \"Strong spin\")")
         })
     }
 }
 
 /// The cavitation penalty the penalty continuation starts from (Newton converges from the
-/// Hertz start with it on every mesh measured; README "The cavitation penalty and the finer
-/// ring").
+/// Hertz start with it on every mesh measured; docs/numerics.md "The cavitation penalty
+/// xi").
 const PENALTY_START: f64 = 1e3;
 
 /// Newton defaults (overridable by PETSc options).
@@ -1001,8 +1001,8 @@ pub fn set_newton_defaults() -> petsc::Result<()> {
 /// while the residual is large, tight near the solution). The LU is 87 % of a monolithic
 /// step (table2-ue2, narrow ring 0.015625 a: 5.1 s per factorisation, 0.16 s per
 /// triangular solve); from level 1's pressure this took 10-11 iterations and 41-42 s
-/// instead of 9 and 66-71 s, to the same film (README "Solver options"). From the Hertz
-/// start it took 17 iterations and 59 s instead of 13 and 102 s there, but it made
+/// instead of 9 and 66-71 s, to the same film (docs/performance.md "Solver options").
+/// From the Hertz start it took 17 iterations and 59 s instead of 13 and 102 s there, but it made
 /// spin-0.33deg fail, so the Hertz start keeps exact Newton (the user can ask for the
 /// reuse everywhere: `-snes_lag_preconditioner 3 -ksp_type gmres -snes_ksp_ew`, and for
 /// exact Newton everywhere: `-snes_lag_preconditioner 1 -ksp_type preonly -snes_ksp_ew false`).

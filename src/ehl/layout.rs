@@ -1,4 +1,4 @@
-//! The unknowns of the full EHL system in one PETSc vector (physics.md sections 5-6):
+//! The unknowns of the full EHL system in one PETSc vector (docs/model.md sections 5-6):
 //! the displacements U of the equivalent solid, the pressure P at the P2 nodes of the
 //! contact face strictly inside the Reynolds rectangle (P = 0 on its edges), and H0.
 //!
@@ -104,7 +104,7 @@ impl Layout {
         0.5 * (c[0] * c[0] + c[2] * c[2])
     }
 
-    /// Film thickness H = H0 + (X^2 + Z^2)/2 - U_y at contact node `n` (physics.md Eq. 5).
+    /// Film thickness H = H0 + (X^2 + Z^2)/2 - U_y at contact node `n` (docs/model.md section 5).
     pub fn film(&self, mesh: &Mesh, x: &[f64], n: u32) -> f64 {
         x[self.h0 as usize] + Self::gap(mesh.nodes[n as usize]) - self.uy(x, n)
     }

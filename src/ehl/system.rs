@@ -2,7 +2,7 @@
 //!   elasticity:      K U + c M^T P = 0                    (U rows; c = E'/(pi E_eq))
 //!   Reynolds:        R(P, H(U, H0)) + penalty(P) = 0       (P rows)
 //!   load balance:    integral of P over the Reynolds domain - W = 0   (H0 row)
-//! with the film H = H0 + (X^2 + Z^2)/2 - U_y (physics.md Eq. 5, dimensionless).
+//! with the film H = H0 + (X^2 + Z^2)/2 - U_y (docs/model.md section 5, dimensionless).
 //! Only the Reynolds rows depend on the iterate, so after the first assembly the Jacobian
 //! keeps its U and H0 rows and only the P rows are zeroed and refilled.
 use super::layout::Layout;

@@ -1,4 +1,4 @@
-//! The friction pass (physics.md section 7): on the converged pressure and film, the shear
+//! The friction pass (docs/model.md section 7): on the converged pressure and film, the shear
 //! stress on the disc surface at every point of the Reynolds rectangle Omega_c, from the
 //! per-point law of [`super::shear`], and its integrals, the traction forces on the disc
 //! Fx, Fz and the friction coefficients fx = Fx/L, fz = Fz/L.

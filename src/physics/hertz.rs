@@ -1,5 +1,5 @@
-//! Hertz theory of the dry circular contact (physics.md section 2) and the equivalent
-//! solid that replaces ball and disc in the elastic model (physics.md section 6).
+//! Hertz theory of the dry circular contact (docs/model.md section 2) and the equivalent
+//! solid that replaces ball and disc in the elastic model (docs/model.md section 6).
 use std::f64::consts::PI;
 
 /// An isotropic linear elastic material.
@@ -42,7 +42,7 @@ pub fn reduced_modulus(b: Material, d: Material) -> f64 {
     2.0 / (b.plane_strain_compliance() + d.plane_strain_compliance())
 }
 
-/// The equivalent solid of physics.md section 6: one elastic body whose surface
+/// The equivalent solid of docs/model.md section 6: one elastic body whose surface
 /// displacement under a pressure equals the sum of the two bodies' displacements.
 ///
 /// Solves (1 - nu_eq^2)/E_eq = sum_i (1 - nu_i^2)/E_i and

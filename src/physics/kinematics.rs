@@ -1,4 +1,4 @@
-//! Surface velocities of ball B and disc D on the contact plane (physics.md section 3, the
+//! Surface velocities of ball B and disc D on the contact plane (docs/model.md section 3, the
 //! paper's lost Eqs. (1)-(2)).
 //!
 //! Frame: x rolling direction, y normal (disc towards ball), z transverse; origin at the
@@ -230,7 +230,7 @@ mod tests {
     #[test]
     fn spin_centre_where_the_mean_velocity_vanishes() {
         // R_B = 0.08 m, R_D = 0.04 m, Ue = 3 m/s, SRR = 5 %; z_c = -2 Ue/(omega_B cos lambda +
-        // omega_D) evaluated by hand (physics.md section 3): -1.33999572e-3 m at 0.5 deg
+        // omega_D) evaluated by hand (docs/model.md section 3): -1.33999572e-3 m at 0.5 deg
         // (outside the Hertz circle, a = 0.92e-3 m), -6.7550108e-4 m at 0.25 deg (inside).
         for (deg, zc) in [(0.5, -1.33999572e-3), (0.25, -6.7550108e-4)] {
             let k = Kinematics::new(3.0, 0.05, f64::to_radians(deg), 0.08, 0.04).unwrap();

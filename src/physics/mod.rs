@@ -1,6 +1,6 @@
 //! Physics of the EHL point contact as small pure functions and types, PETSc-free.
 //!
-//! Every item names the paper symbol it implements (see `docs/physics.md` of the project):
+//! Every item names the paper symbol it implements (see `docs/model.md`):
 //! - [`hertz`]: reduced modulus E', Hertz radius a and peak pressure p_H, equivalent solid.
 //! - [`rheology`]: viscosity laws eta(p) (Roelands, Barus, constant) and density laws
 //!   rho(p) (Dowson-Higginson, incompressible), each with its exact derivative d/dp for the

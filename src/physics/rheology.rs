@@ -1,4 +1,4 @@
-//! Lubricant laws (physics.md section 4): viscosity eta(p) and density rho(p), each with
+//! Lubricant laws (docs/model.md section 4): viscosity eta(p) and density rho(p), each with
 //! its exact derivative with respect to pressure (the Newton Jacobian needs both).
 //!
 //! Negative pressures: the penalty cavitation model lets p be slightly negative, and a

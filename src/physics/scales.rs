@@ -1,4 +1,4 @@
-//! Dimensionless scaling (physics.md section 5) and the Moes dimensionless groups.
+//! Dimensionless scaling (docs/model.md section 5) and the Moes dimensionless groups.
 //!
 //! The solver works in Hertzian units: X = x/a, Z = z/a, P = p/p_H, H = h R/a^2, and the
 //! same scale for the normal displacement, U2 = u2 R/a^2. In these units the Hertzian

@@ -1,4 +1,4 @@
-//! Cavitation by penalty (physics.md section 5): the term xi * area_i * pen(P_i) is added to
+//! Cavitation by penalty (docs/model.md section 5): the term xi * area_i * pen(P_i) is added to
 //! Reynolds row i (lumped at the nodes), with pen a C1 version of min(P, 0). Where the film
 //! cavitates the penalty balances the Reynolds residual and holds P at -O(1/xi); where
 //! P >= 0 it is exactly zero, so it never perturbs the pressurised film.

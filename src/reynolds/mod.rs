@@ -3,7 +3,7 @@
 //! Pure Rust, no PETSc: the caller (assembly, Newton driver) owns the mesh and the global
 //! vectors and calls [`reynolds_element`] on each triangle.
 //!
-//! # Equation (physics.md section 5, dimensionless)
+//! # Equation (docs/model.md section 5, dimensionless)
 //! X = x/a, Z = z/a, P = p/p_H, H = h R/a^2, rho_bar = rho/rho_R, eta_bar = eta/eta_R,
 //! v = (u_bar, w_bar) = (Um, Wm)/Ue. On the rectangle Omega, with P = 0 on its boundary:
 //!

@@ -1,6 +1,6 @@
 //! Assembly of the equivalent solid's elasticity system into PETSc objects.
 //!
-//! Dimensionless form (physics.md sections 5-6): X = x/a, U = u R/a^2, P = p/p_H. With
+//! Dimensionless form (docs/model.md sections 5-6): X = x/a, U = u R/a^2, P = p/p_H. With
 //! sigma = E_eq C~(nu_eq) : eps, the weak form becomes
 //!   integral C~ eps(U) : eps(V) dX = -(E'/(pi E_eq)) integral_{Omega_c} P V_y dS,
 //! so the stiffness uses a unit Young's modulus and the traction carries the factor

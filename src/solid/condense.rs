@@ -274,9 +274,9 @@ fn schur_complement(mesh: &Mesh, part: &crate::mesh::Partition, dofs: &DofMap, n
     pcall!(ffi::ISCreateGeneral(selfc, nr as i32, idx.as_ptr(), ffi::PetscCopyMode_PETSC_COPY_VALUES, &mut is.0))?;
     let mut f = OwnedMat(std::ptr::null_mut());
     pcall!(ffi::MatGetFactor(k.raw(), ffi::MATSOLVERMUMPS.as_ptr() as *const _, ffi::MatFactorType_MAT_FACTOR_CHOLESKY, &mut f.0))?;
-    // Own options prefix: the 3D elastic factorisation wants PORD (-elastic_mat_mumps_icntl_7 4,
-    // 2-5 times faster than AMD here, see ../shared/docs/petsc-notes.md) while the dense
-    // Newton matrix of the condensed system wants AMD (-mat_mumps_icntl_7 0).
+    // Own options prefix: the 3D elastic factorisation takes PORD (-elastic_mat_mumps_icntl_7 4,
+    // the fastest Debian MUMPS ordering on 3D elasticity) whatever the options of the Newton
+    // matrix say (docs/performance.md "Solver options").
     pcall!(ffi::MatSetOptionsPrefix(f.0, ELASTIC_PREFIX.as_ptr()))?;
     pcall!(ffi::MatFactorSetSchurIS(f.0, is.0))?;
     let mut info: ffi::MatFactorInfo = unsafe { std::mem::zeroed() };

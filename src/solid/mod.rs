@@ -1,4 +1,4 @@
-//! The equivalent elastic solid (physics.md section 6): DOF numbering, assembly of the
+//! The equivalent elastic solid (docs/model.md section 6): DOF numbering, assembly of the
 //! P2 elasticity system and of contact-face pressure loads.
 pub mod assembly;
 pub mod condense;
