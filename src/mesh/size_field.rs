@@ -193,7 +193,7 @@ mod tests {
         f.grade();
         assert_eq!(f.min_over([0.0, 0.0], [0.55, 0.55]), 0.05);
         // A box right of the rectangle, 1 a away: the edge cells' size plus 1 a.
-        let edge = f.at(1.0, 0.55);
+        let edge = f.min_over([1.0, 0.5], [1.0, 0.6]);
         assert!((f.min_over([2.0, 0.5], [2.5, 0.6]) - (edge + 1.0)).abs() < 1e-12);
         // A box over the whole field: a lower bound, never above the true minimum.
         let mut g = SizeField::new(square(), 0.001, 1.0, 0.5);
