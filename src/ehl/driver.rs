@@ -17,7 +17,7 @@ use super::layout::Layout;
 use super::prealloc::preallocation;
 use super::condensed::CondensedSystem;
 use super::system::{EhlParams, EhlProblem, EhlSystem, Lubricant};
-use crate::app::Context;
+use crate::context::Context;
 use crate::case::Scene;
 use crate::mesh::{Mesh, Partition};
 use crate::petsc::snes::{Snes, SolveReport};

@@ -355,7 +355,7 @@ impl Problem for EhlSystem<'_> {
                 break;
             }
         }
-        let any_bad = crate::app::collective::max_f64(self.world, if bad.is_some() { 1.0 } else { 0.0 });
+        let any_bad = crate::collective::max_f64(self.world, if bad.is_some() { 1.0 } else { 0.0 });
         if any_bad > 0.0 {
             return Ok(Eval::Domain(bad.unwrap_or_else(|| "non-positive film on another rank".into())));
         }
