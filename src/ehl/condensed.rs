@@ -58,14 +58,13 @@ struct Element {
     face: [usize; 6],
     /// The pressure unknowns each of the 6 nodes takes its pressure from, with weights
     /// (unknown -1 or weight 0: none; the Dirichlet edges have no unknown): the node's own
-    /// unknown, or with a P1 pressure the vertices it interpolates.
+    /// unknown with weight 1. Kept as a prolongation T (pressure unknowns to nodal
+    /// pressures) so that another pressure space changes only this table.
     t: [[(i32, f64); 2]; 6],
     verts: [[f64; 2]; 3],
     vel: [[f64; 2]; 3],
     /// Load weights (integral of each pressure basis function over the element).
     w: [f64; 6],
-    /// Linear sub-triangle (P1-iso-P2 pressure): only the first 3 nodes are used.
-    linear: bool,
     /// Touches a row this rank owns.
     mine: bool,
 }
@@ -205,18 +204,13 @@ pub struct CondensedSystem<'a> {
     pub params: EhlParams,
     pub lubricant: Lubricant,
     elements: Vec<Element>,
-    /// Face index of each pressure unknown.
-    p_face: Vec<usize>,
-    /// Nodal area (integral of the P2 or P1 hat function) of each pressure unknown.
+    /// Nodal area (a sixth of each P2 triangle at the node) of each pressure unknown.
     p_area: Vec<f64>,
     /// The block of the dense Jacobian this rank fills (default: its rows, all columns).
     fill: FillBlock,
     /// Rigid gap at each face node.
     gap: Vec<f64>,
     row_scale: Vec<f64>,
-    /// Pseudo-transient term (dt, rho H at the previous pseudo time at each P unknown's
-    /// node): area_j (rho_j H_j - old_j) / dt is added to Reynolds row j. None: steady.
-    pseudo: Option<(f64, Vec<f64>)>,
     pub residual_evals: usize,
     pub jacobian_evals: usize,
     pub step_limits: Vec<f64>,
@@ -239,8 +233,6 @@ impl<'a> CondensedSystem<'a> {
         let (lo, hi) = (layout.ranges[rank], layout.ranges[rank + 1].min(layout.n_p));
         let mut node_area = vec![0.0; comp.rows.len()];
         let mut elements = Vec::new();
-        let linear = crate::reynolds::p1iso_pressure();
-        let p1 = crate::reynolds::p1_pressure();
         let owned = |d: i32| d >= 0 && (d as usize) >= lo && (d as usize) < hi;
         for tri in &mesh.contact_tris {
             let xz = |n: u32| {
@@ -249,42 +241,13 @@ impl<'a> CondensedSystem<'a> {
             };
             let face = tri.map(|n| layout.face_index[n as usize] as usize);
             let p = tri.map(|n| layout.p_index[n as usize]);
-            if linear {
-                for sub in crate::reynolds::P2_SUB_TRIANGLES {
-                    let verts = sub.map(|k| xz(tri[k]));
-                    let area = tri_area(&verts);
-                    let f6: [usize; 6] = std::array::from_fn(|i| face[sub[i.min(2)]]);
-                    let t: [[(i32, f64); 2]; 6] = std::array::from_fn(|i| if i < 3 { [(p[sub[i]], 1.0), (-1, 0.0)] } else { [(-1, 0.0); 2] });
-                    let w: [f64; 6] = std::array::from_fn(|i| if i < 3 { area / 3.0 } else { 0.0 });
-                    for i in 0..3 {
-                        node_area[f6[i]] += area / 3.0;
-                    }
-                    let mut e = Element { face: f6, t, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w, linear: true, mine: false };
-                    e.mine = e.any_dof(owned);
-                    elements.push(e);
-                }
-                continue;
-            }
             let verts = [xz(tri[0]), xz(tri[1]), xz(tri[2])];
             let area = tri_area(&verts);
-            if p1 {
-                // The P1 hat of a vertex integrates to a third of each triangle it touches.
-                for &f in &face[..3] {
-                    node_area[f] += area / 3.0;
-                }
-            } else {
-                for &f in &face {
-                    node_area[f] += area / 6.0;
-                }
+            for &f in &face {
+                node_area[f] += area / 6.0;
             }
-            let t: [[(i32, f64); 2]; 6] = std::array::from_fn(|k| {
-                let mut entries = [(-1, 0.0); 2];
-                for (m, (v, w)) in crate::solid::condense::pressure_of_node(k, p1).enumerate() {
-                    entries[m] = (p[v], w);
-                }
-                entries
-            });
-            let mut e = Element { face, t, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w: p2_tri_weights(area), linear: false, mine: false };
+            let t: [[(i32, f64); 2]; 6] = std::array::from_fn(|k| [(p[k], 1.0), (-1, 0.0)]);
+            let mut e = Element { face, t, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w: p2_tri_weights(area), mine: false };
             e.mine = e.any_dof(owned);
             elements.push(e);
         }
@@ -301,12 +264,10 @@ impl<'a> CondensedSystem<'a> {
             params,
             lubricant,
             elements,
-            p_face,
             p_area,
             fill,
             gap,
             row_scale,
-            pseudo: None,
             residual_evals: 0,
             jacobian_evals: 0,
             step_limits: Vec::new(),
@@ -364,19 +325,9 @@ impl<'a> CondensedSystem<'a> {
         self.lubricant.fluid(self.params.lambda_bar)
     }
 
-    /// Residual and Jacobian of one element (P2, or a linear sub-triangle padded to 6 nodes).
+    /// Residual and Jacobian of one P2 element.
     fn eval(&self, e: &Element, p: &[f64; 6], h: &[f64; 6], fluid: &Fluid) -> ElementOut {
-        if !e.linear {
-            return reynolds_element(&e.verts, p, h, &e.vel, fluid, &self.params.stabilisation);
-        }
-        let (r, dp, dh) = crate::reynolds::p1::reynolds_p1_element_stab(&e.verts, &[p[0], p[1], p[2]], &[h[0], h[1], h[2]], &e.vel, fluid, &self.params.stabilisation);
-        let mut out = ElementOut { r: [0.0; 6], dr_dp: [[0.0; 6]; 6], dr_dh: [[0.0; 6]; 6] };
-        for i in 0..3 {
-            out.r[i] = r[i];
-            out.dr_dp[i][..3].copy_from_slice(&dp[i]);
-            out.dr_dh[i][..3].copy_from_slice(&dh[i]);
-        }
-        out
+        reynolds_element(&e.verts, p, h, &e.vel, fluid, &self.params.stabilisation)
     }
 
     /// The element's 6 nodal pressures (T P on the element).
@@ -474,17 +425,6 @@ impl<'a> CondensedSystem<'a> {
 }
 
 impl EhlProblem for CondensedSystem<'_> {
-    /// Switches the pseudo-transient term on with step `dt`, the old state being `x`
-    /// (pseudo-transient continuation: the steady solution does not depend on it).
-    fn set_pseudo_time(&mut self, dt: Option<f64>, x: &[f64]) -> bool {
-        self.pseudo = dt.map(|dt| {
-            let h = self.film(x);
-            let old = self.p_face.iter().enumerate().map(|(j, &f)| (self.lubricant.rho)(x[j]).0 * h[f]).collect();
-            (dt, old)
-        });
-        true
-    }
-
     fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64) {
         self.params.set_operating(lambda_bar, penalty);
         self.lubricant = lubricant;
@@ -572,11 +512,6 @@ impl Problem for CondensedSystem<'_> {
         for j in self.owned_p() {
             r[j - lo] += self.params.penalty * self.p_area[j] * penalty_law(x[j]).0;
         }
-        if let Some((dt, old)) = &self.pseudo {
-            for j in self.owned_p() {
-                r[j - lo] += self.p_area[j] * ((self.lubricant.rho)(x[j]).0 * h[self.p_face[j]] - old[j]) / dt;
-            }
-        }
         for (i, v) in r.iter_mut().enumerate() {
             *v *= self.row_scale[lo + i];
         }
@@ -653,7 +588,7 @@ impl Problem for CondensedSystem<'_> {
 
     fn jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
         self.jacobian_evals += 1;
-        if self.comp.is_rigid() && self.pseudo.is_none() {
+        if self.comp.is_rigid() {
             return self.jacobian_rigid(x, j);
         }
         let np = self.layout.n_p;
@@ -700,22 +635,6 @@ impl Problem for CondensedSystem<'_> {
             let diag = fb.col_of(jn as i32);
             if let Some(c) = diag {
                 row[c] += self.params.penalty * area * penalty_slope(x[jn]);
-            }
-            if let Some((dt, _)) = &self.pseudo {
-                let f = self.p_face[jn];
-                let (rho, drho) = (self.lubricant.rho)(x[jn]);
-                // d(rho H)/dP_k = rho' H delta_jk - rho C[f, k]; d/dH0 = rho.
-                if let Some(c) = diag {
-                    row[c] += area * drho * h[f] / dt;
-                }
-                if !self.comp.is_rigid() {
-                    for (a, c) in row.iter_mut().zip(fb.c_row(self.comp, f)) {
-                        *a -= area * rho * c / dt;
-                    }
-                }
-                if let Some(c) = h0_col {
-                    row[c] += area * rho / dt;
-                }
             }
             let s = self.row_scale[jn];
             row.iter_mut().for_each(|v| *v *= s);

@@ -354,30 +354,20 @@ pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: 
 }
 
 /// Whether `coupling` with `n_p` pressure unknowns (in a `sweep` or not) means the
-/// monolithic system. The experimental P1 pressures (`EHL_P1P`, `EHL_P1ISO`) exist on the
-/// condensed path only.
+/// monolithic system.
 fn monolithic(coupling: crate::case::Coupling, n_p: usize, sweep: bool) -> Result<bool, String> {
     use crate::case::Coupling as C;
-    let p1 = crate::reynolds::p1_pressure() || crate::reynolds::p1iso_pressure();
     match coupling {
-        C::Monolithic if p1 => Err("reynolds.coupling = \"monolithic\" is not available with the experimental P1 pressures (EHL_P1P, EHL_P1ISO): use \"condensed\" or \"auto\"".into()),
         C::Monolithic => Ok(true),
         C::Condensed => Ok(false),
-        C::Auto => Ok(!p1 && n_p > if sweep { crate::case::AUTO_MONOLITHIC_ABOVE_SWEEP } else { crate::case::AUTO_MONOLITHIC_ABOVE }),
+        C::Auto => Ok(n_p > if sweep { crate::case::AUTO_MONOLITHIC_ABOVE_SWEEP } else { crate::case::AUTO_MONOLITHIC_ABOVE }),
     }
 }
 
 /// The face nodes that carry a pressure unknown in the condensed system, in
-/// `mesh.contact_nodes` order: every P2 node off the Dirichlet edges, or with a P1 pressure
-/// ([`crate::reynolds::p1_pressure`]) the triangles' vertices among them.
+/// `mesh.contact_nodes` order: every P2 node off the Dirichlet edges.
 fn pressure_nodes(mesh: &Mesh, layout: &Layout) -> Vec<u32> {
-    let mut vertex = vec![!crate::reynolds::p1_pressure(); mesh.nodes.len()];
-    for tri in &mesh.contact_tris {
-        for &n in &tri[..3] {
-            vertex[n as usize] = true;
-        }
-    }
-    mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0 && vertex[n as usize]).collect()
+    mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect()
 }
 
 /// Options prefix of the condensed Newton Jacobian (`-condensed_mat_type aij` with
@@ -441,19 +431,6 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     let mut x = vec![0.0; layout.total()];
     for (j, &n) in comp.cols.iter().enumerate() {
         x[layout.p[n as usize] as usize] = out.x[j];
-    }
-    if crate::reynolds::p1_pressure() {
-        // P1 pressure: the mid-side nodes take the mean of their edge's vertices (0 on the
-        // Dirichlet edges), the P2 field the rest of the code reads.
-        for tri in &mesh.contact_tris {
-            for k in 3..6 {
-                let d = layout.p[tri[k] as usize];
-                if d >= 0 {
-                    let v = |n: u32| Layout::value(&x, layout.p[n as usize]);
-                    x[d as usize] = crate::solid::condense::pressure_of_node(k, true).map(|(i, w)| w * v(tri[i])).sum();
-                }
-            }
-        }
     }
     for (i, &n) in comp.rows.iter().enumerate() {
         let d = layout.u[n as usize][1];
@@ -700,68 +677,6 @@ fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlPr
     let mut last = report;
     // The converged state of the base problem.
     let mut state: Option<Vec<f64>> = if last.converged { Some(x.gather_all().map_err(pe)?) } else { None };
-    // 2. Experimental (developer switch EHL_PTC, condensed path only): pseudo-transient
-    //    continuation from the same start: implicit pseudo-time steps of the transient Reynolds equation, the
-    //    step growing as the steady residual falls (switched evolution relaxation), then
-    //    Newton on the steady problem.
-    if !last.converged {
-        let steady_norm = |system: &mut dyn EhlProblem, xs: &[f64]| -> Result<f64, String> {
-            let f = Vector::new(comm, local).map_err(pe)?;
-            f.set_all(0.0).map_err(pe)?;
-            match system.residual(xs, &f).map_err(pe)? {
-                crate::petsc::snes::Eval::Ok => {}
-                crate::petsc::snes::Eval::Domain(_) => return Ok(f64::INFINITY),
-            }
-            f.assemble().map_err(pe)?;
-            f.norm2().map_err(pe)
-        };
-        if std::env::var_os("EHL_PTC").is_some() && system.set_pseudo_time(None, x0) {
-            system.set_operating(lambda_bar(&base), lubricant(&base), penalty(&base));
-            if scaling {
-                system.scale_rows(x0).map_err(pe)?;
-            }
-            let mut xk = x0.to_vec();
-            let mut fk = steady_norm(system, &xk)?;
-            let f_start = fk;
-            let mut dt: f64 = std::env::var("EHL_PTC_DT0").ok().and_then(|v| v.parse().ok()).unwrap_or(0.05);
-            let (mut n_steps, mut its) = (0usize, 0usize);
-            let mut ok = false;
-            while n_steps < 200 && dt > 1e-8 {
-                system.set_pseudo_time(Some(dt), &xk);
-                x.set_local_values(&xk[lo..hi]).map_err(pe)?;
-                let r = snes.solve(system, &x, j).map_err(pe)?;
-                its += r.iterations;
-                n_steps += 1;
-                if !r.converged {
-                    dt *= 0.25;
-                    continue;
-                }
-                let xn = x.gather_all().map_err(pe)?;
-                system.set_pseudo_time(None, &xn);
-                let fnew = steady_norm(system, &xn)?;
-                if std::env::var_os("EHL_DEBUG").is_some() {
-                    ctx.log(format!("pseudo-time step {n_steps}: dt = {dt:.3e}, {} its, steady residual {fnew:.3e}", r.iterations));
-                }
-                dt *= (fk / fnew).clamp(0.5, 4.0);
-                xk = xn;
-                fk = fnew;
-                if fk < 1e-3 * f_start || dt > 1e4 {
-                    ok = true;
-                    break;
-                }
-            }
-            system.set_pseudo_time(None, &xk);
-            newton_total.set(newton_total.get() + its);
-            note(format!("pseudo-transient continuation: {n_steps} pseudo-time steps ({its} iterations), steady residual {:.2e} of the start's{}", fk / f_start, if ok { "" } else { " (gave up)" }));
-            let r = solve_scene(&base, system, &xk)?;
-            newton_total.set(newton_total.get() + r.iterations);
-            note(format!("Newton on the steady problem: {} ({} iterations)", r.reason, r.iterations));
-            if r.converged {
-                state = Some(x.gather_all().map_err(pe)?);
-            }
-            last = r;
-        }
-    }
     // One Newton solve of `sc0` changed by homotopy `h` at t, from `start`; the step is
     // logged and kept in the path. Returns the report and, if converged, the state.
     let solve_h = |sc0: &Scene, h: &Homotopy, t: f64, system: &mut dyn EhlProblem, start: &[f64], what: String| -> Result<(SolveReport, Option<Vec<f64>>), String> {

@@ -277,12 +277,6 @@ pub trait EhlProblem: Problem {
     /// sizes differ by ten orders of magnitude (eps ~ 1e4 at the inlet, ~1e-9 in the
     /// contact); scaled, the residual norm that the line search watches weighs them alike.
     fn scale_rows(&mut self, x: &[f64]) -> Result<()>;
-    /// Pseudo-transient continuation: adds (rho H - (rho H)_old)/dt to the Reynolds rows,
-    /// the old state being `x`; `None` restores the steady problem. Returns false if the
-    /// problem does not support it.
-    fn set_pseudo_time(&mut self, _dt: Option<f64>, _x: &[f64]) -> bool {
-        false
-    }
     /// Replaces the entrainment velocity field (continuation in the tilt angle). Returns
     /// false if the problem does not support it.
     fn set_velocity(&mut self, _velocity: Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync>) -> bool {

@@ -89,7 +89,6 @@
 pub mod cavitation;
 pub mod dual;
 pub mod element;
-pub mod p1;
 pub mod p2;
 pub mod quadrature;
 
@@ -106,28 +105,3 @@ pub use p2::P2Triangle;
 /// The 4 sub-triangles of a P2 triangle (local nodes v0, v1, v2, m01, m12, m20), same
 /// orientation as the parent.
 pub const P2_SUB_TRIANGLES: [[usize; 3]; 4] = [[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]];
-
-/// A P1 pressure (linear on each P2 face triangle, unknowns at its 3 vertices) as a P2
-/// field: local node k of the P2 triangle takes `sum w P(v)` over its entries `(v, w)` here
-/// (a vertex its own value, a mid-side node the mean of its edge's two vertices; weight 0
-/// pads the vertices' second entry). This is the prolongation T with P2 = T P1.
-pub const P1_IN_P2: [[(usize, f64); 2]; 6] = [
-    [(0, 1.0), (0, 0.0)],
-    [(1, 1.0), (1, 0.0)],
-    [(2, 1.0), (2, 0.0)],
-    [(0, 0.5), (1, 0.5)],
-    [(1, 0.5), (2, 0.5)],
-    [(2, 0.5), (0, 0.5)],
-];
-
-/// Developer switch (experimental, condensed path only): P1 pressure on the vertices of the
-/// P2 face triangles with the P2 film (`EHL_P1P=1`; see [`P1_IN_P2`]).
-pub fn p1_pressure() -> bool {
-    std::env::var_os("EHL_P1P").is_some()
-}
-
-/// Developer switch (experimental, condensed path only): pressure linear on the 4
-/// sub-triangles of every P2 face triangle (`EHL_P1ISO=1`).
-pub fn p1iso_pressure() -> bool {
-    std::env::var_os("EHL_P1ISO").is_some()
-}
