@@ -22,6 +22,7 @@ pub mod collective;
 pub mod context;
 pub mod ehl;
 pub mod fem;
+pub mod ehl_options;
 pub mod interrupt;
 pub mod friction;
 pub mod mesh;

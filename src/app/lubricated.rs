@@ -272,7 +272,7 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
             "newton_iterations": sol.newton_total, "snes_reason": sol.report.reason,
             "residual_norm": sol.report.residual_norm,
             "dofs_elastic": n_u, "dofs_reynolds": n_p, "path": sol.steps, "half_domain": setup.half,
-            "penalty": scene.reynolds.penalty, "stabilisation": scene.reynolds.stabilisation.as_str(), "coupling": sol.coupling,
+            "penalty": scene.reynolds.penalty, "stabilisation": scene.reynolds.stabilisation.as_str(), "coupling": sol.coupling.name(),
         },
         "timing": { "mesh_s": setup.mesh_s, "assembly_s": sol.assembly_s, "solve_s": sol.solve_s, "post_s": t_post.elapsed().as_secs_f64(), "total_s": ctx.start.elapsed().as_secs_f64() },
         "peak_rss_mb": peak,

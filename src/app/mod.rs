@@ -80,6 +80,17 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
         }
     };
     crate::interrupt::install();
+    match crate::ehl_options::read(crate::petsc::comm_world()) {
+        Ok(o) => {
+            if let Some(font) = &o.plot_font {
+                crate::output::plot::set_font_file(font);
+            }
+        }
+        Err(e) => {
+            eprintln!("ehl-petsc: error: cannot read the -ehl_ options: {e}");
+            return 3;
+        }
+    }
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {

@@ -1,11 +1,13 @@
 //! The EHL system with the elastic block condensed onto the contact face
 //! (see [`crate::solid::condense`]): unknowns P at the Reynolds nodes and H0 only,
-//!   Reynolds:      R(P, H(P, H0)) + penalty(P) = 0,   H = H0 + (X^2 + Z^2)/2 + C P
-//!   load balance:  integral of P - W = 0.
-//! It has the same solution as the monolithic system of [`super::system`] (exact
-//! elimination of U). The Jacobian is dense in P (every pressure deflects every face
-//! node): dR/dP + dR/dH C, assembled row by row into a dense-pattern AIJ matrix that MUMPS
-//! factorises; its size is set by the Reynolds mesh alone, not by the 3D mesh.
+//!   Reynolds:      R(P, H(P, H0)) + penalty(P) = 0,   H = H0 + (X^2 + Z^2)/2 - C P
+//!   load balance:  integral of P - W = 0,
+//! with U_y = C P the face deflection. It has the same solution as the monolithic system of
+//! [`super::system`] (exact elimination of U). The Jacobian is dense in P (every pressure
+//! deflects every face node): dR/dP - dR/dH C, filled block by block into a dense matrix
+//! (options prefix `condensed_`; ScaLAPACK's LU on 2+ ranks, LAPACK's on one; for rigid
+//! solids a sparse AIJ matrix); its size is set by the Reynolds mesh alone, not by the 3D
+//! mesh.
 use super::system::{clip_pressure_step, p2_tri_weights, penalty_law, pressure_step_floor, tri_area, EhlParams, Lubricant, CAVITATION_SMOOTHING};
 use super::system::EhlProblem;
 use crate::mesh::Mesh;
@@ -406,22 +408,6 @@ impl<'a> CondensedSystem<'a> {
         }
         Ok(())
     }
-
-    /// Developer aid (EHL_DEBUG): appends the iterate's centre lines to /tmp/ehl_debug_lines.csv.
-    fn debug_dump(&self, x: &[f64], h: &[f64]) {
-        use std::io::Write;
-        let Some(mesh) = self.debug_mesh else { return };
-        let mut f = std::fs::OpenOptions::new().create(true).append(true).open("/tmp/ehl_debug_lines.csv").unwrap();
-        let it = self.step_limits.len();
-        for (i, &n) in self.comp.rows.iter().enumerate() {
-            let c = mesh.nodes[n as usize];
-            if c[2].abs() < 1e-9 || c[0].abs() < 1e-9 {
-                let j = self.layout.p_index[n as usize];
-                let p = if j >= 0 { x[j as usize] } else { 0.0 };
-                let _ = writeln!(f, "{it},{},{},{},{}", c[0], c[2], p, h[i]);
-            }
-        }
-    }
 }
 
 impl EhlProblem for CondensedSystem<'_> {
@@ -522,13 +508,13 @@ impl Problem for CondensedSystem<'_> {
                 None => self.load(x) - self.params.load,
             };
         }
-        if std::env::var_os("EHL_DEBUG").is_some() {
+        if crate::ehl_options::get().monitor {
             if let Some(mesh) = self.debug_mesh {
                 let np = self.layout.n_p;
                 let mut order: Vec<usize> = (0..r.len()).filter(|&i| lo + i < np).collect();
                 order.sort_by(|&a, &b| r[b].abs().partial_cmp(&r[a].abs()).unwrap());
                 let norm: f64 = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-                let mut msg = format!("EHL_DEBUG rank {} |r| = {norm:.3e}; worst:", self.rank);
+                let mut msg = format!("ehl_monitor: rank {} |r| = {norm:.3e}; worst:", self.rank);
                 for &i in order.iter().take(4) {
                     let n = self.comp.cols[lo + i];
                     let c = mesh.nodes[n as usize];
@@ -557,14 +543,10 @@ impl Problem for CondensedSystem<'_> {
 
     fn limit_step(&mut self, x: &[f64], y: &[f64]) -> Result<f64> {
         const FILM_KEEP: f64 = 0.2;
-        let h = self.film(x);
-        if std::env::var_os("EHL_NO_LIMIT").is_some() {
-            if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
-                self.step_limits.push(1.0);
-                self.debug_dump(x, &h);
-            }
+        if !crate::ehl_options::get().film_limiter {
             return Ok(1.0);
         }
+        let h = self.film(x);
         let dh0 = y[self.layout.h0()];
         // x_new = x - y: H_new = H - (dh0 - duy)
         let dh: Vec<f64> = self.comp.apply(&y[..self.layout.n_p]).iter().map(|duy| dh0 - duy).collect();
@@ -577,11 +559,10 @@ impl Problem for CondensedSystem<'_> {
             self.collapse = Some(self.face_xz(k).unwrap_or([f64::NAN; 2]));
             return Ok(0.0);
         }
-        if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
+        if crate::ehl_options::get().monitor && self.rank == 0 {
             let k = (0..h.len()).min_by(|&a, &b| h[a].partial_cmp(&h[b]).unwrap()).unwrap();
             let at = self.face_xz(k).map(|c| format!(" (X, Z) = ({:.3}, {:.3})", c[0], c[1])).unwrap_or_default();
-            eprintln!("EHL_DEBUG limiter {s:.3e}; H0 = {:.4e} dH0 = {dh0:.3e}; min H = {:.3e} at node {}{at}", x[self.layout.h0()], h[k], self.comp.rows[k]);
-            self.debug_dump(x, &h);
+            eprintln!("ehl_monitor: limiter {s:.3e}; H0 = {:.4e} dH0 = {dh0:.3e}; min H = {:.3e} at node {}{at}", x[self.layout.h0()], h[k], self.comp.rows[k]);
         }
         Ok(s)
     }

@@ -39,14 +39,10 @@ pub fn p2_tri_weights(area: f64) -> [f64; 6] {
 
 pub use crate::reynolds::cavitation::{clip_pressure_step, penalty_law, CAVITATION_SMOOTHING, PRESSURE_STEP_FLOOR};
 
-/// The floor of a Newton step's nodal pressure ([`PRESSURE_STEP_FLOOR`]); the developer
-/// switch `EHL_P_FLOOR` sets another value, or `off`.
+/// The floor of a Newton step's nodal pressure ([`PRESSURE_STEP_FLOOR`]); the options
+/// `-ehl_pressure_step_floor VALUE` and `-ehl_pressure_step_clip false` change it.
 pub fn pressure_step_floor() -> Option<f64> {
-    match std::env::var("EHL_P_FLOOR") {
-        Ok(v) if v == "off" => None,
-        Ok(v) => Some(v.parse().expect("EHL_P_FLOOR: a number or off")),
-        Err(_) => Some(PRESSURE_STEP_FLOOR),
-    }
+    crate::ehl_options::get().pressure_step_floor
 }
 
 /// Lubricant laws in dimensionless form: eta_bar(P), rho_bar(P) with their P-derivatives.
@@ -387,7 +383,7 @@ impl Problem for EhlSystem<'_> {
                 f.set_values(&[d], &[self.scale_of(d) * self.params.penalty * area * v], true)?;
             }
         }
-        if std::env::var_os("EHL_DEBUG").is_some() {
+        if crate::ehl_options::get().monitor {
             let mut maxr: f64 = 0.0;
             let mut at = 0;
             let fluid2 = self.fluid();
@@ -399,12 +395,12 @@ impl Problem for EhlSystem<'_> {
                 if m > maxr { maxr = m; at = k; }
             }
             let e = &self.elements[at];
-            eprintln!("EHL_DEBUG max |R_reynolds| = {maxr:.3e} at element {:?} P = {:?} H = {:?}", e.verts, self.element_pressure(x, e), self.element_film(x, e));
-            eprintln!("EHL_DEBUG max |KU| = {:.3e}, h0 = {}", ku.iter().fold(0.0f64, |a, b| a.max(b.abs())), x[self.layout.h0 as usize]);
+            eprintln!("ehl_monitor: max |R_reynolds| = {maxr:.3e} at element {:?} P = {:?} H = {:?}", e.verts, self.element_pressure(x, e), self.element_film(x, e));
+            eprintln!("ehl_monitor: max |KU| = {:.3e}, h0 = {}", ku.iter().fold(0.0f64, |a, b| a.max(b.abs())), x[self.layout.h0 as usize]);
         }
         let target = if self.rank == self.layout.ranges.len() - 2 { -self.params.load } else { 0.0 };
         f.set_values(&[self.layout.h0], &[load_part + target], true)?;
-        if std::env::var_os("EHL_DEBUG").is_some() {
+        if crate::ehl_options::get().monitor {
             f.assemble()?;
             let all = f.gather_all()?;
             if self.rank == 0 {
@@ -421,7 +417,7 @@ impl Problem for EhlSystem<'_> {
                     }
                 }
                 let c = self.mesh.nodes[worst_at];
-                eprintln!("EHL_DEBUG |F_U| = {:.3e} |F_P| = {:.3e} |F_H0| = {:.3e}; worst P row {:.3e} at ({:.3}, {:.3}) P = {:.4} H = {:.4}",
+                eprintln!("ehl_monitor: |F_U| = {:.3e} |F_P| = {:.3e} |F_H0| = {:.3e}; worst P row {:.3e} at ({:.3}, {:.3}) P = {:.4} H = {:.4}",
                     nu.sqrt(), np.sqrt(), all[self.layout.h0 as usize].abs(), worst, c[0], c[2], x[self.layout.p[worst_at] as usize],
                     self.layout.film(self.mesh, x, worst_at as u32));
             }
@@ -442,15 +438,15 @@ impl Problem for EhlSystem<'_> {
                 n += 1;
             }
         }
-        if n > 0 && std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
-            eprintln!("EHL_DEBUG pressure step clipped at {n} nodes (floor {floor})");
+        if n > 0 && crate::ehl_options::get().monitor && self.rank == 0 {
+            eprintln!("ehl_monitor: pressure step clipped at {n} nodes (floor {floor})");
         }
         Ok(n)
     }
 
     fn limit_step(&mut self, x: &[f64], y: &[f64]) -> Result<f64> {
         const FILM_KEEP: f64 = 0.2;
-        if std::env::var_os("EHL_NO_LIMIT").is_some() {
+        if !crate::ehl_options::get().film_limiter {
             return Ok(1.0);
         }
         let dh0 = y[self.layout.h0 as usize];
@@ -471,8 +467,8 @@ impl Problem for EhlSystem<'_> {
             self.collapse = Some([c[0], c[2]]);
             return Ok(0.0);
         }
-        if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
-            eprintln!("EHL_DEBUG step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e} binding at X,Z,H,dH = {at:?}", x[self.layout.h0 as usize]);
+        if crate::ehl_options::get().monitor && self.rank == 0 {
+            eprintln!("ehl_monitor: step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e} binding at X,Z,H,dH = {at:?}", x[self.layout.h0 as usize]);
         }
         Ok(s)
     }

@@ -7,7 +7,7 @@
 //! ([`super::write_atomic`]).
 //!
 //! Text is rendered from the TrueType file [`FONT_PATH`] (Debian package `fonts-dejavu-core`),
-//! read at run time; the environment variable `EHL_PLOT_FONT` may name another TTF file. If the
+//! read at run time; the option `-ehl_plot_font FILE` ([`set_font_file`]) names another. If the
 //! font cannot be read every plot function fails with an error naming the package.
 //!
 //! All input must be finite (and positive on a log axis); otherwise the functions return `Err`.
@@ -19,24 +19,31 @@ use std::sync::OnceLock;
 pub const FONT_PATH: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
 static FONT: OnceLock<Result<FontVec, String>> = OnceLock::new();
+static FONT_FILE: OnceLock<String> = OnceLock::new();
+
+/// Uses the TrueType font `path` instead of [`FONT_PATH`] (before the first plot; later
+/// calls have no effect).
+pub fn set_font_file(path: &str) {
+    let _ = FONT_FILE.set(path.to_string());
+}
 
 fn load_font(path: &str) -> Result<FontVec, String> {
     let bytes = std::fs::read(path).map_err(|e| {
         format!(
             "plot font '{path}' cannot be read ({e}): install the Debian package fonts-dejavu-core \
-             (apt-get install fonts-dejavu-core) or set EHL_PLOT_FONT to a TrueType font file"
+             (apt-get install fonts-dejavu-core) or give -ehl_plot_font FILE, a TrueType font file"
         )
     })?;
     FontVec::try_from_vec(bytes).map_err(|_| format!("plot font '{path}' is not a valid TrueType font"))
 }
 
 fn font() -> Result<&'static FontVec, String> {
-    FONT.get_or_init(|| load_font(&std::env::var("EHL_PLOT_FONT").unwrap_or_else(|_| FONT_PATH.to_string())))
+    FONT.get_or_init(|| load_font(FONT_FILE.get().map_or(FONT_PATH, |f| f.as_str())))
         .as_ref()
         .map_err(|e| e.clone())
 }
 
-/// Loads the plot font once (from `EHL_PLOT_FONT` or [`FONT_PATH`]); every plot function calls it
+/// Loads the plot font once (from [`set_font_file`] or [`FONT_PATH`]); every plot function calls it
 /// first, so a missing font is an error before any drawing.
 pub fn ensure_font() -> Result<(), String> {
     font().map(|_| ())

@@ -141,7 +141,7 @@ pub fn face_compliance(world: &SimpleCommunicator, mesh: &Mesh, nu: f64, tractio
         return Err(rust_error("static condensation of the elastic block failed on rank 0 (see its message)"));
     }
     world.process_at_rank(0).broadcast_into(&mut s[..]);
-    let dbg = std::env::var_os("EHL_DEBUG").is_some();
+    let dbg = crate::ehl_options::get().monitor;
     if dbg && world.rank() == 0 {
         eprintln!("condense: S on every rank {:.2} s", t0.elapsed().as_secs_f64());
     }
@@ -215,7 +215,7 @@ fn schur_complement(mesh: &Mesh, part: &crate::mesh::Partition, dofs: &DofMap, n
     let selfc = unsafe { ffi::RSMPI_COMM_SELF };
     let t = std::time::Instant::now();
     let k = assemble_stiffness(selfc, mesh, part, dofs, 0, nu)?;
-    let dbg = std::env::var_os("EHL_DEBUG").is_some();
+    let dbg = crate::ehl_options::get().monitor;
     if dbg { eprintln!("condense: K assembled {:.2} s", t.elapsed().as_secs_f64()); }
     // K is symmetric positive definite (clamped base): MUMPS LDL^T without pivoting.
     pcall!(ffi::MatSetOption(k.raw(), ffi::MatOption_MAT_SPD, ffi::PetscBool_PETSC_TRUE))?;
