@@ -7,7 +7,7 @@ use super::{collective, Context};
 use crate::case::{FrictionModel, Scene};
 use crate::ehl::driver::{self, EhlSolution, EhlSolver};
 use crate::ehl::{layout::Layout, post::FieldsOnFace};
-use crate::friction::pass::{friction_pass, stress_at, FrictionResult, FrictionSetup};
+use crate::friction::pass::{friction_pass, stress_at, FaceSolution, FrictionResult, FrictionSetup};
 use crate::friction::shear::ShearLaw;
 use crate::mesh::{self, Mesh};
 use crate::solid::dofmap::DofMap;
@@ -402,4 +402,24 @@ fn write_face_vtu(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, f
     }
     let path = dir.join("contact_face.vtu");
     crate::output::write_atomic_with(&path, |t| write_vtu_single_type(t, &points, 22, &conn, &vtu_fields, &[]).map_err(|e| format!("cannot write {}: {e}", t.display())))
+}
+
+/// The friction pass reads the EHL solution through [`FaceSolution`] (so `friction` does
+/// not depend on `ehl`).
+impl FaceSolution for crate::ehl::post::FieldsOnFace<'_> {
+    fn mesh(&self) -> &crate::mesh::Mesh {
+        self.mesh
+    }
+    fn p_node(&self, n: u32) -> f64 {
+        crate::ehl::post::FieldsOnFace::p_node(self, n)
+    }
+    fn h_node(&self, n: u32) -> f64 {
+        crate::ehl::post::FieldsOnFace::h_node(self, n)
+    }
+    fn half(&self) -> bool {
+        crate::ehl::post::FieldsOnFace::half(self)
+    }
+    fn locate(&self, x: f64, z: f64) -> Option<(usize, [f64; 3])> {
+        crate::ehl::post::FieldsOnFace::locate(self, x, z)
+    }
 }

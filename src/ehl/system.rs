@@ -6,6 +6,7 @@
 //! Only the Reynolds rows depend on the iterate, so after the first assembly the Jacobian
 //! keeps its U and H0 rows and only the P rows are zeroed and refilled.
 use super::layout::Layout;
+use crate::fem::p2tri::{p2_tri_mass, p2_tri_weights, tri_area};
 use crate::mesh::{Mesh, Partition};
 use crate::petsc::snes::{Eval, Problem};
 use crate::petsc::{ffi, Matrix, Result, Vector};
@@ -13,29 +14,6 @@ use crate::pcall;
 use crate::reynolds::element::{reynolds_element, Fluid, Stabilisation};
 use crate::solid::dofmap::DofMap;
 use mpi::topology::SimpleCommunicator;
-
-/// Mass matrix of a straight P2 triangle, integral of N_i N_j (closed form, area/180 * ...).
-pub fn p2_tri_mass(area: f64) -> [[f64; 6]; 6] {
-    const M: [[f64; 6]; 6] = [
-        [6., -1., -1., 0., -4., 0.],
-        [-1., 6., -1., 0., 0., -4.],
-        [-1., -1., 6., -4., 0., 0.],
-        [0., 0., -4., 32., 16., 16.],
-        [-4., 0., 0., 16., 32., 16.],
-        [0., -4., 0., 16., 16., 32.],
-    ];
-    M.map(|row| row.map(|m| m * area / 180.0))
-}
-
-/// Signed-area-free triangle area in the (X, Z) plane.
-pub fn tri_area(v: &[[f64; 2]; 3]) -> f64 {
-    0.5 * ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1])).abs()
-}
-
-/// Integral of the P2 basis functions over a triangle: 0 at vertices, area/3 at midpoints.
-pub fn p2_tri_weights(area: f64) -> [f64; 6] {
-    [0.0, 0.0, 0.0, area / 3.0, area / 3.0, area / 3.0]
-}
 
 pub use crate::reynolds::cavitation::{clip_pressure_step, penalty_law, CAVITATION_SMOOTHING, PRESSURE_STEP_FLOOR};
 
@@ -124,7 +102,7 @@ pub struct EhlSystem<'a> {
     /// Step-limiter factors applied at each Newton step (1 = full Newton step).
     pub step_limits: Vec<f64>,
     /// Where (X, Z) the film closed in the last solve, if it did (see
-    /// [`super::condensed::FILM_COLLAPSE`]).
+    /// [`super::step::FILM_COLLAPSE`]).
     pub collapse: Option<[f64; 2]>,
     /// Constant scale of each Reynolds row (indexed by global row), 1 by default; see
     /// [`EhlSystem::scale_rows`].
@@ -454,7 +432,7 @@ impl Problem for EhlSystem<'_> {
         let h: Vec<f64> = nodes.iter().map(|&n| self.layout.film(self.mesh, x, n)).collect();
         // x_new = x - y: H_new = H - (dh0 - duy)
         let dh: Vec<f64> = nodes.iter().map(|&n| dh0 - self.layout.uy(y, n)).collect();
-        let (s, binding) = super::condensed::film_step_limit(&h, &dh, FILM_KEEP);
+        let (s, binding) = super::step::film_step_limit(&h, &dh, FILM_KEEP);
         let at = binding.map(|k| {
             let c = self.mesh.nodes[nodes[k] as usize];
             [c[0], c[2], h[k], dh[k]]
@@ -462,7 +440,7 @@ impl Problem for EhlSystem<'_> {
         self.step_limits.push(s);
         // As in the condensed system: Newton keeps pushing one nodal film through zero, so
         // stop this solve (a zero step fails the line search at once).
-        if let Some(k) = binding.filter(|&k| h[k] < super::condensed::FILM_COLLAPSE) {
+        if let Some(k) = binding.filter(|&k| h[k] < super::step::FILM_COLLAPSE) {
             let c = self.mesh.nodes[nodes[k] as usize];
             self.collapse = Some([c[0], c[2]]);
             return Ok(0.0);

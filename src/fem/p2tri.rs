@@ -91,6 +91,29 @@ pub fn p2_tri_node_coords(verts: &[[f64; 2]; 3]) -> [[f64; 2]; 6] {
     x
 }
 
+/// Mass matrix of a straight P2 triangle, integral of N_i N_j (closed form, area/180 * ...).
+pub fn p2_tri_mass(area: f64) -> [[f64; 6]; 6] {
+    const M: [[f64; 6]; 6] = [
+        [6., -1., -1., 0., -4., 0.],
+        [-1., 6., -1., 0., 0., -4.],
+        [-1., -1., 6., -4., 0., 0.],
+        [0., 0., -4., 32., 16., 16.],
+        [-4., 0., 0., 16., 32., 16.],
+        [0., -4., 0., 16., 16., 32.],
+    ];
+    M.map(|row| row.map(|m| m * area / 180.0))
+}
+
+/// Area of a straight triangle in the (X, Z) plane (unsigned).
+pub fn tri_area(v: &[[f64; 2]; 3]) -> f64 {
+    0.5 * ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1])).abs()
+}
+
+/// Integral of the P2 basis functions over a triangle: 0 at vertices, area/3 at midpoints.
+pub fn p2_tri_weights(area: f64) -> [f64; 6] {
+    [0.0, 0.0, 0.0, area / 3.0, area / 3.0, area / 3.0]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

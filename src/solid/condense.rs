@@ -95,7 +95,7 @@ fn face_mass(mesh: &Mesh, rows: &[u32], cols: &[u32]) -> Vec<f64> {
             let c = mesh.nodes[n as usize];
             [c[0], c[2]]
         };
-        let m = crate::ehl::system::p2_tri_mass(crate::ehl::system::tri_area(&[xz(tri[0]), xz(tri[1]), xz(tri[2])]));
+        let m = crate::fem::p2tri::p2_tri_mass(crate::fem::p2tri::tri_area(&[xz(tri[0]), xz(tri[1]), xz(tri[2])]));
         for a in 0..6 {
             let i = row_of[tri[a] as usize];
             if i < 0 {

@@ -53,7 +53,7 @@ impl<'s> Start<'s> {
 pub(super) fn elastic_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &Partition, dofs: &DofMap, k: &Matrix, nu: f64, p: &dyn Fn(f64, f64) -> f64) -> petsc::Result<Vec<f64>> {
     let nodal = |v: &[[f64; 2]; 3]| -> [f64; 6] {
         let p = crate::fem::p2tri::p2_tri_node_coords(v).map(|q| p(q[0], q[1]));
-        let m = crate::ehl::system::p2_tri_mass(crate::ehl::system::tri_area(v));
+        let m = crate::fem::p2tri::p2_tri_mass(crate::fem::p2tri::tri_area(v));
         std::array::from_fn(|i| (0..6).map(|j| m[i][j] * p[j]).sum())
     };
     let b = assembly::assemble_pressure_load(comm, mesh, part, dofs, ctx.rank, assembly::traction_factor(nu), &nodal)?;
