@@ -135,7 +135,7 @@ pub fn friction_pass(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<Fri
         }
         let tf = TriFields::new(fields, t);
         let area = crate::fem::p2tri::tri_area(&tf.v) * s.a * s.a;
-        for q in crate::reynolds::quadrature::DUNAVANT6.iter() {
+        for q in crate::fem::quadrature::DUNAVANT6.iter() {
             let tau = tf.stress(s, q.l)?;
             fx_n += q.w * area * tau[0];
             fz_n += q.w * area * tau[1];

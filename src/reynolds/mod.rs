@@ -27,8 +27,9 @@
 //! (f = 0 for the physical problem; [`reynolds_element_with_source`] takes an f(X, Z) for
 //! manufactured solutions.)
 //!
-//! Quadrature: Dunavant's 12-point degree-6 rule ([`quadrature::DUNAVANT6`]), all weights
-//! positive, points interior.
+//! Element and quadrature from [`crate::fem`]: the straight P2 triangle
+//! ([`crate::fem::p2tri::P2Triangle`]) and Dunavant's 12-point degree-6 rule
+//! ([`crate::fem::quadrature::DUNAVANT6`]), all weights positive, points interior.
 //!
 //! # SUPG stabilisation (consistent, residual based)
 //! When [`Stabilisation::supg`] is set, each element adds
@@ -81,7 +82,7 @@
 //! evaluated when SUPG is on). Verified against central finite differences in the tests.
 //!
 //! Not included here (the caller's business): the cavitation penalty, the load balance
-//! (use [`p2::P2Triangle::load_weights`] for int P), the elastic coupling H(U_y).
+//! (use [`crate::fem::p2tri::P2Triangle::load_weights`] for int P), the elastic coupling H(U_y).
 
 // Index loops mirror the formulas (N_i, dR_i/dP_j) in this numeric code.
 #![allow(clippy::needless_range_loop)]
@@ -89,8 +90,6 @@
 pub mod cavitation;
 pub mod dual;
 pub mod element;
-pub mod p2;
-pub mod quadrature;
 
 #[cfg(test)]
 mod tests;
@@ -100,7 +99,6 @@ pub use element::{
     reynolds_element, reynolds_element_with_source, streamline_length, xi, ElementOut, Fluid,
     Stabilisation,
 };
-pub use p2::P2Triangle;
 
 /// The 4 sub-triangles of a P2 triangle (local nodes v0, v1, v2, m01, m12, m20), same
 /// orientation as the parent.
