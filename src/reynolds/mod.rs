@@ -15,7 +15,7 @@
 //! by its values at the three vertices.
 //!
 //! # Discretisation
-//! Straight P2 triangles ([`p2`]), local nodes v0, v1, v2, mid(0,1), mid(1,2), mid(2,0);
+//! Straight P2 triangles ([`crate::fem::p2tri::P2Triangle`]), local nodes v0, v1, v2, mid(0,1), mid(1,2), mid(2,0);
 //! P and H are both P2 fields given by nodal values (H = H0 + (X^2+Z^2)/2 - U_y is exactly
 //! P2 when U_y is; the caller computes the nodal H).
 //!

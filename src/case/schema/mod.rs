@@ -4,7 +4,7 @@
 //! Keep each `*_FIELDS` list in step with the struct above it: the test
 //! `known_keys_match_structs` serialises a full scene and checks both directions.
 //!
-//! The top level and the physical sections are here; [`effects`] and [`numerics`] hold the
+//! The top level and the physical sections are here; `effects` and `numerics` hold the
 //! rest (the macros below are defined before them, so they see them).
 use std::fmt;
 

@@ -1,12 +1,12 @@
 //! The lubricated solve: builds the coupled system, starts Newton (PETSc SNES) from the dry
 //! Hertz state or a given start, and falls back to an automatic continuation when Newton
 //! fails from the Hertz start. The parts, each in its own file:
-//! - [`problem`]: the scene as a dimensionless problem (lambda_bar, lubricant laws,
+//! - `problem`: the scene as a dimensionless problem (lambda_bar, lubricant laws,
 //!   velocity field, penalty, stabilisation);
-//! - [`start`]: where Newton starts;
-//! - [`continuation`]: Newton with the continuation, a list of homotopies (parameter, ramp);
-//! - [`policy`]: the coupling ([`Coupling`]) and the PETSc options each solve sets;
-//! - [`diagnostics`]: why the film closed, the finite-difference Jacobian check.
+//! - `start`: where Newton starts;
+//! - `continuation`: Newton with the continuation, a list of homotopies (parameter, ramp);
+//! - `policy`: the coupling ([`Coupling`]) and the PETSc options each solve sets;
+//! - `diagnostics`: why the film closed, the finite-difference Jacobian check.
 //!
 //! Developer options (`-ehl_...`, listed by `-help`) are read by [`crate::ehl_options`].
 mod continuation;
@@ -130,7 +130,7 @@ impl<'a> EhlSolver<'a> {
     /// automatic continuation). Collective.
     ///
     /// On the monolithic coupling a start other than the Hertz start first reuses the LU
-    /// over Newton steps ([`Policy::reuses_lu`]); if that fails, the same start is solved
+    /// over Newton steps (`Policy::reuses_lu`); if that fails, the same start is solved
     /// again with an LU at every step before the Hertz start is tried.
     pub fn solve_from(&self, ctx: &Context, scene: &Scene, start: Start) -> Result<EhlSolution, String> {
         let once = |start: Start, reuse_lu: bool| match &self.comp {

@@ -18,7 +18,7 @@ pub enum Coupling {
 
 impl Coupling {
     /// The coupling for `scene` with `n_p` pressure unknowns: rigid solids are rigid, else
-    /// the scene's `reynolds.coupling` ([`monolithic`]).
+    /// the scene's `reynolds.coupling` (`monolithic`).
     pub fn of_scene(scene: &Scene, n_p: usize) -> Coupling {
         if scene.effects.elasticity == crate::case::ElasticityModel::Rigid {
             Coupling::Rigid
@@ -80,7 +80,7 @@ pub(super) struct Policy {
 
 impl Policy {
     /// How Newton proceeds from `start`; `reuse_lu`: the monolithic coupling may reuse
-    /// its LU over Newton steps (see [`Policy::reuses_lu`]).
+    /// its LU over Newton steps (see `Policy::reuses_lu`).
     pub(super) fn for_start(start: &Start, reuse_lu: bool) -> Policy {
         Policy {
             // Only from the Hertz start: another start falls back to the Hertz start instead.
@@ -117,7 +117,7 @@ pub fn set_newton_defaults() -> petsc::Result<()> {
 /// The linear solve of a Newton step (each overridable by PETSc options).
 ///
 /// `reuse_lu` (the monolithic coupling from a start near the solution, see
-/// [`Policy::reuses_lu`]): the MUMPS LU of the sparse Jacobian is rebuilt every third Newton step and
+/// `Policy::reuses_lu`): the MUMPS LU of the sparse Jacobian is rebuilt every third Newton step and
 /// GMRES solves on the last one, to the Eisenstat-Walker tolerance (inexact Newton: loose
 /// while the residual is large, tight near the solution). The LU is 87 % of a monolithic
 /// step (table2-ue2, narrow ring 0.015625 a: 5.1 s per factorisation, 0.16 s per

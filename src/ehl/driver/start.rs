@@ -18,7 +18,7 @@ pub enum Start<'s> {
     /// The dry Hertz pressure and its deflection, H0 from Hamrock-Dowson's central film.
     Hertz,
     /// A converged state of a neighbouring operating point on the same mesh (monolithic
-    /// layout, as in [`EhlSolution::x`]).
+    /// layout, as in [`super::EhlSolution::x`]).
     Previous(&'s [f64]),
     /// A pressure field P(X, Z) from another mesh (mesh sequencing: a coarser level's
     /// converged solution, interpolated), its deflection, and H0 so that the central film
