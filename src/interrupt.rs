@@ -52,7 +52,7 @@ pub fn message(sig: i32, during: &str) -> String {
     format!("interrupted by {} during {during}; stopped on every rank, no result of this solve was written", signal_name(sig))
 }
 
-/// Collective over PETSC_COMM_WORLD: the largest signal number any rank received (0 if
+/// Collective over MPI_COMM_WORLD (PETSc's world communicator): the largest signal number any rank received (0 if
 /// none). Every rank must call it at the same point.
 pub fn collective_signal() -> i32 {
     let local = LOCAL.load(Ordering::SeqCst);
@@ -66,7 +66,7 @@ pub fn collective_signal() -> i32 {
             1,
             mpi::ffi::RSMPI_INT32_T,
             mpi::ffi::RSMPI_MAX,
-            crate::petsc::comm_world(),
+            mpi::ffi::RSMPI_COMM_WORLD,
         );
     }
     if all != 0 {

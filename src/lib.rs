@@ -8,6 +8,8 @@
 //! - [`fem`]: quadrature, reference elements and element kernels (pure, PETSc-free).
 //! - [`petsc`]: FFI bindings and safe RAII wrappers; no physics.
 //! - [`output`]: summary.json and other result files.
+//! - [`context`], [`collective`]: the run's shared state (rank, log, output folder) and
+//!   making an outcome agreed by every rank.
 //! - [`interrupt`]: SIGINT/SIGTERM, stopping every rank together.
 //! - [`regress`]: summary.json comparison (regression runner) and the hard suite's checks.
 // `!(x > 0.0)` is written on purpose throughout: it rejects NaN as well as x <= 0.
@@ -16,8 +18,11 @@
 #![allow(clippy::macro_metavars_in_unsafe)]
 pub mod app;
 pub mod case;
+pub mod collective;
+pub mod context;
 pub mod ehl;
 pub mod fem;
+pub mod ehl_options;
 pub mod interrupt;
 pub mod friction;
 pub mod mesh;

@@ -10,6 +10,8 @@ Defaults: -ksp_type preonly -pc_type lu; MUMPS (-mat_mumps_icntl_7 4, PORD) for 
   the dense condensed EHL Jacobian: -pc_factor_mat_solver_type scalapack (2+ ranks) or petsc
   (LAPACK, 1 rank); -condensed_mat_type aij -pc_factor_mat_solver_type mumps returns to MUMPS.
 Useful: -log_view, -ksp_view, -options_left (lists options nobody used), -mat_mumps_icntl_4 2.
+The solver's own options (-ehl_monitor, -ehl_check_jacobian, -ehl_supg_delta, ...) are listed
+  with the others by -help after the scene.
 Exit codes: 0 success, 1 solve failed or did not converge, 2 bad scene or output folder, 3 PETSc start-up,
   130/143 interrupted by SIGINT/SIGTERM (all ranks stop at the next check; no result of the
   interrupted solve is written).";

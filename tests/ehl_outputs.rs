@@ -22,6 +22,10 @@ fn converged_lubricated_run_writes_all_outputs() {
     assert!(err < 1e-6, "load error {err}");
     let (hc, hm) = (s["film"]["hc_m"].as_f64().unwrap(), s["film"]["hm_m"].as_f64().unwrap());
     assert!(hc > 0.0 && hm > 0.0 && hm <= hc, "hc {hc} hm {hm}");
+    // The typed summary the readers use (restart, paper-findings) reads the same file.
+    let typed = ehl_petsc::output::summary::Summary::read(&out_dir).unwrap();
+    assert_eq!((typed.film.hc_m, typed.film.hm_m, typed.pressure.load_error_rel), (hc, hm, err));
+    assert_eq!(typed.solver.path.len(), s["solver"]["path"].as_array().unwrap().len());
     for f in ["profile_x0.csv", "profile_z0.csv"] {
         let text = std::fs::read_to_string(out_dir.join(f)).unwrap();
         assert!(text.starts_with("x_m,z_m,p_pa,h_m\n"), "{f}");

@@ -64,7 +64,7 @@ fn failed_sweep_point_is_reported_and_the_sweep_goes_on() {
     let scene = sweep_scene().replace("tilt_angle = [90.0, 2.0]", "tilt_angle = [90.0, 45.0, 30.0]");
     let path = write_scene(&dir, "scene.toml", &scene);
     let out_dir = dir.join("out");
-    let out = mpirun_env(2, &[path.as_str(), "--output", out_dir.to_str().unwrap()], &[("EHL_FAIL_POINT", "2")]);
+    let out = mpirun(2, &[path.as_str(), "--output", out_dir.to_str().unwrap(), "-ehl_fail_point", "2"]);
     let t = text(&out);
     assert_ne!(out.status.code(), Some(0), "a failed point must end the run non-zero:\n{t}");
     assert!(t.contains("1 of 3 sweep points failed"), "{t}");

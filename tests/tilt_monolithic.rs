@@ -1,5 +1,5 @@
 //! The tilt continuation on both couplings: a spin scene solved through the tilt
-//! continuation (plain Newton skipped, `EHL_SKIP_PLAIN`) with the condensed and with the
+//! continuation (plain Newton skipped, `-ehl_skip_plain`) with the condensed and with the
 //! monolithic coupling. Both are the same discrete problem on the same path, so they must
 //! take the path and reach the same film. Before 2026-11-25 the monolithic system could not
 //! change its velocity field, skipped the tilt continuation, and a spin scene above 4,000
@@ -23,8 +23,9 @@ fn solve(coupling: &str) -> (String, serde_json::Value) {
         "--set", "effects.friction=none",
         "--set", &set,
         "--output", out_dir.to_str().unwrap(),
+        "-ehl_skip_plain",
     ];
-    let out = mpirun_env(2, &args, &[("EHL_SKIP_PLAIN", "1")]);
+    let out = mpirun(2, &args);
     let t = text(&out);
     assert_eq!(out.status.code(), Some(0), "{t}");
     (t, summary(&out_dir))

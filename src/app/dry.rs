@@ -6,7 +6,6 @@ use crate::case::Scene;
 use crate::mesh::{self, Mesh};
 use crate::petsc::{self, Ksp, Vector};
 use crate::solid::{assembly, dofmap::DofMap, hertz_load};
-use serde_json::json;
 use std::time::Instant;
 
 /// Depth of the recursive splitting of contact triangles cut by the Hertz circle.
@@ -107,35 +106,36 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let peak_total = collective::sum_f64(&ctx.world, crate::output::peak_rss_mb());
     let total_s = ctx.start.elapsed().as_secs_f64();
     if ctx.rank == 0 {
-        let summary = json!({
-            "case": scene.name,
-            "ranks": ctx.size,
-            "converged": true,
-            "hertz": { "a_m": hertz.a, "ph_pa": hertz.ph, "e_prime_pa": hertz.e_prime },
-            "equivalent_solid": { "e_pa": eq.e, "nu": eq.nu },
-            "mesh": {
-                "elements": mesh.tets.len(),
-                "nodes": mesh.nodes.len(),
-                "dofs_total": dofs.total(),
-                "contact_triangles": mesh.contact_tris.len(),
-                "contact_size_a": mesh.contact_size,
-                "worst_quality": quality.min_dihedral_deg,
-                "worst_quality_measure": "minimum dihedral angle (degrees)",
-                "max_aspect_ratio": quality.max_aspect_ratio,
+        use crate::output::summary::*;
+        let summary = DrySummary {
+            case: scene.name.clone(),
+            ranks: ctx.size,
+            converged: true,
+            hertz: HertzSummary { a_m: hertz.a, ph_pa: hertz.ph, e_prime_pa: hertz.e_prime },
+            equivalent_solid: EquivalentSolidSummary { e_pa: eq.e, nu: eq.nu },
+            mesh: MeshSummary {
+                elements: mesh.tets.len(),
+                nodes: mesh.nodes.len(),
+                dofs_total: dofs.total(),
+                contact_triangles: mesh.contact_tris.len(),
+                contact_size_a: mesh.contact_size,
+                worst_quality: quality.min_dihedral_deg,
+                worst_quality_measure: "minimum dihedral angle (degrees)".into(),
+                max_aspect_ratio: Some(quality.max_aspect_ratio),
             },
-            "elastic": {
-                "u2_center_m": u_c * scale,
-                "u2_edge_m": u_a * scale,
-                "u2_center_halfspace_m": -scale,
-                "u2_difference_halfspace_m": -0.5 * scale,
-                "traction_load_error_rel": load_error_rel,
+            elastic: ElasticSummary {
+                u2_center_m: u_c * scale,
+                u2_edge_m: u_a * scale,
+                u2_center_halfspace_m: -scale,
+                u2_difference_halfspace_m: -0.5 * scale,
+                traction_load_error_rel: load_error_rel,
             },
-            "timing": { "mesh_s": mesh_s, "assembly_s": assembly_s, "solve_s": solve_s, "total_s": total_s },
-            "peak_rss_mb": peak,
-            "peak_rss_mb_all_ranks": peak_total,
-            "scene": scene,
-        });
-        ctx.write_summary(&summary)?;
+            timing: Timing { mesh_s, assembly_s, solve_s, post_s: None, total_s, condensation_s: None, friction_s: None },
+            peak_rss_mb: peak,
+            peak_rss_mb_all_ranks: peak_total,
+            scene: scene.clone(),
+        };
+        ctx.write_summary(&to_json(&summary)?)?;
     }
     Ok(())
 }

@@ -7,7 +7,7 @@ use super::{collective, Context};
 use crate::case::{FrictionModel, Scene};
 use crate::ehl::driver::{self, EhlSolution, EhlSolver};
 use crate::ehl::{layout::Layout, post::FieldsOnFace};
-use crate::friction::pass::{friction_pass, stress_at, FrictionResult, FrictionSetup};
+use crate::friction::pass::{friction_pass, stress_at, FaceSolution, FrictionResult, FrictionSetup};
 use crate::friction::shear::ShearLaw;
 use crate::mesh::{self, Mesh};
 use crate::solid::dofmap::DofMap;
@@ -256,49 +256,70 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
     let hd = scene.hamrock_dowson();
     let (n_u, n_p) = layout.counts();
     let kin = scene.kinematics().expect("lubricated scene");
-    let mut summary = json!({
-        "case": scene.name,
-        "ranks": ctx.size,
-        "converged": sol.report.converged,
-        "hertz": { "a_m": a, "ph_pa": ph, "e_prime_pa": hertz.e_prime },
-        "operating": { "load_n": scene.operating.load, "entrainment_speed_m_s": scene.operating.entrainment_speed, "slide_to_roll": scene.operating.slide_to_roll, "tilt_angle_deg": scene.operating.tilt_angle },
-        "kinematics": {
-            "model": scene.effects.kinematics.as_str(),
-            "omega_B_rad_s": kin.omega_b, "omega_D_rad_s": kin.omega_d, "U_BO_m_s": kin.u_bo, "U_DO_m_s": kin.u_do,
-            "spin_centre_z_m": kin.spin_centre(),
+    use crate::output::summary::*;
+    let summary = Summary {
+        case: scene.name.clone(),
+        ranks: ctx.size,
+        converged: sol.report.converged,
+        hertz: HertzSummary { a_m: a, ph_pa: ph, e_prime_pa: hertz.e_prime },
+        operating: OperatingSummary { load_n: scene.operating.load, entrainment_speed_m_s: scene.operating.entrainment_speed, slide_to_roll: scene.operating.slide_to_roll, tilt_angle_deg: scene.operating.tilt_angle },
+        kinematics: KinematicsSummary {
+            model: scene.effects.kinematics.as_str().to_string(),
+            omega_b_rad_s: kin.omega_b,
+            omega_d_rad_s: kin.omega_d,
+            u_bo_m_s: kin.u_bo,
+            u_do_m_s: kin.u_do,
+            spin_centre_z_m: kin.spin_centre(),
         },
-        "mesh": {
-            "elements": mesh.tets.len(), "nodes": mesh.nodes.len(), "dofs_total": layout.total(),
-            "contact_triangles": mesh.contact_tris.len(), "contact_size_a": mesh.contact_size,
-            "worst_quality": setup.worst_quality, "worst_quality_measure": "minimum dihedral angle (degrees)",
+        mesh: MeshSummary {
+            elements: mesh.tets.len(),
+            nodes: mesh.nodes.len(),
+            dofs_total: layout.total(),
+            contact_triangles: mesh.contact_tris.len(),
+            contact_size_a: mesh.contact_size,
+            worst_quality: setup.worst_quality,
+            worst_quality_measure: "minimum dihedral angle (degrees)".into(),
+            max_aspect_ratio: None,
         },
-        "film": {
-            "hc_m": st.hc * hs, "hm_m": st.hm * hs, "hm_x_m": st.hm_at[0] * a, "hm_z_m": st.hm_at[1] * a, "h0_m": st.h0 * hs,
-            "hc_hamrock_dowson_m": hd.map(|h| h.central_film_thickness()),
-            "hm_hamrock_dowson_m": hd.map(|h| h.minimum_film_thickness()),
+        film: FilmSummary {
+            hc_m: st.hc * hs,
+            hm_m: st.hm * hs,
+            hm_x_m: st.hm_at[0] * a,
+            hm_z_m: st.hm_at[1] * a,
+            h0_m: st.h0 * hs,
+            hc_hamrock_dowson_m: hd.map(|h| h.central_film_thickness()),
+            hm_hamrock_dowson_m: hd.map(|h| h.minimum_film_thickness()),
         },
-        "pressure": { "pmax_pa": st.pmax * ph, "pmax_x_m": st.pmax_at[0] * a, "pmax_z_m": st.pmax_at[1] * a, "pmin_pa": st.pmin * ph, "pmin_nodes_pa": st.pmin_nodes * ph, "load_error_rel": load_error },
-        "moes": scene.moes().map(|m| json!({ "M": m.m, "L": m.l })),
-        "solver": {
-            "newton_iterations": sol.newton_total, "snes_reason": sol.report.reason,
-            "residual_norm": sol.report.residual_norm,
-            "dofs_elastic": n_u, "dofs_reynolds": n_p, "path": sol.steps, "half_domain": setup.half,
-            "penalty": scene.reynolds.penalty, "stabilisation": scene.reynolds.stabilisation.as_str(), "coupling": sol.coupling,
+        pressure: PressureSummary { pmax_pa: st.pmax * ph, pmax_x_m: st.pmax_at[0] * a, pmax_z_m: st.pmax_at[1] * a, pmin_pa: st.pmin * ph, pmin_nodes_pa: st.pmin_nodes * ph, load_error_rel: load_error },
+        moes: scene.moes().map(|m| MoesSummary { m: m.m, l: m.l }),
+        solver: SolverSummary {
+            newton_iterations: sol.newton_total,
+            snes_reason: sol.report.reason.clone(),
+            residual_norm: sol.report.residual_norm,
+            dofs_elastic: n_u,
+            dofs_reynolds: n_p,
+            path: sol.steps.clone(),
+            half_domain: setup.half,
+            penalty: scene.reynolds.penalty,
+            stabilisation: scene.reynolds.stabilisation.as_str().to_string(),
+            coupling: sol.coupling.name().to_string(),
         },
-        "timing": { "mesh_s": setup.mesh_s, "assembly_s": sol.assembly_s, "solve_s": sol.solve_s, "post_s": t_post.elapsed().as_secs_f64(), "total_s": ctx.start.elapsed().as_secs_f64() },
-        "peak_rss_mb": peak,
-        "effects": effects_report(scene, setup.half),
-        "scene": scene,
-    });
-    if let Some(c) = condensation_s {
-        // Only when the elastic block was condensed (not for rigid solids).
-        summary["timing"]["condensation_s"] = json!(c);
-    }
-    if let Some(f) = &friction {
-        summary["friction"] = json!({ "model": scene.effects.friction.as_str(), "fx": f.fx, "fz": f.fz, "Fx_n": f.fx_n, "Fz_n": f.fz_n, "tau_max_pa": f.tau_max });
-        summary["timing"]["friction_s"] = json!(f.seconds);
-    }
-    ctx.write_summary_to(dir, &summary)?;
+        timing: Timing {
+            mesh_s: setup.mesh_s,
+            assembly_s: sol.assembly_s,
+            solve_s: sol.solve_s,
+            post_s: Some(t_post.elapsed().as_secs_f64()),
+            total_s: ctx.start.elapsed().as_secs_f64(),
+            // Only when the elastic block was condensed (not for rigid solids).
+            condensation_s,
+            friction_s: friction.as_ref().map(|f| f.seconds),
+        },
+        peak_rss_mb: peak,
+        effects: effects_report(scene, setup.half),
+        scene: scene.clone(),
+        friction: friction.as_ref().map(|f| FrictionSummary { model: scene.effects.friction.as_str().to_string(), fx: f.fx, fz: f.fz, fx_n: f.fx_n, fz_n: f.fz_n, tau_max_pa: f.tau_max }),
+    };
+    ctx.write_summary_to(dir, &to_json(&summary)?)?;
     Ok(res)
 }
 
@@ -413,4 +434,24 @@ fn write_face_vtu(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, f
     }
     let path = dir.join("contact_face.vtu");
     crate::output::write_atomic_with(&path, |t| write_vtu_single_type(t, &points, 22, &conn, &vtu_fields, &[]).map_err(|e| format!("cannot write {}: {e}", t.display())))
+}
+
+/// The friction pass reads the EHL solution through [`FaceSolution`] (so `friction` does
+/// not depend on `ehl`).
+impl FaceSolution for crate::ehl::post::FieldsOnFace<'_> {
+    fn mesh(&self) -> &crate::mesh::Mesh {
+        self.mesh
+    }
+    fn p_node(&self, n: u32) -> f64 {
+        crate::ehl::post::FieldsOnFace::p_node(self, n)
+    }
+    fn h_node(&self, n: u32) -> f64 {
+        crate::ehl::post::FieldsOnFace::h_node(self, n)
+    }
+    fn half(&self) -> bool {
+        crate::ehl::post::FieldsOnFace::half(self)
+    }
+    fn locate(&self, x: f64, z: f64) -> Option<(usize, [f64; 3])> {
+        crate::ehl::post::FieldsOnFace::locate(self, x, z)
+    }
 }

@@ -1,7 +1,6 @@
 //! The program: reads the scene, starts PETSc, runs the simulation the scene asks for and
 //! writes the results. `main.rs` only parses the command line and calls [`run`].
 pub mod adapt;
-pub mod collective;
 pub mod dry;
 pub mod lubricated;
 pub mod plots;
@@ -9,6 +8,8 @@ pub mod restart;
 pub mod study;
 pub mod sweep;
 
+pub use crate::collective;
+pub use crate::context::Context;
 use crate::case::Scene;
 use crate::petsc::Petsc;
 use mpi::topology::SimpleCommunicator;
@@ -36,48 +37,6 @@ pub struct RunOptions {
     pub study_sequence: bool,
     /// `--start-from DIR`: Newton starts from the converged pressure of an earlier run.
     pub start_from: Option<PathBuf>,
-}
-
-/// Shared state of one run on one rank.
-pub struct Context {
-    pub world: SimpleCommunicator,
-    pub rank: usize,
-    pub size: usize,
-    pub out_dir: PathBuf,
-    pub quiet: bool,
-    pub start: Instant,
-}
-
-impl Context {
-    /// Prints a progress line on rank 0 (stdout), with the elapsed time.
-    pub fn log(&self, msg: impl AsRef<str>) {
-        if self.rank == 0 && !self.quiet {
-            println!("[{:7.2} s] {}", self.start.elapsed().as_secs_f64(), msg.as_ref());
-        }
-    }
-}
-
-impl Context {
-    /// Writes summary.json into the output folder (rank 0 calls it, once, after success;
-    /// atomically, so a failed run leaves no summary behind).
-    pub fn write_summary(&self, summary: &serde_json::Value) -> Result<(), String> {
-        self.write_summary_to(&self.out_dir.clone(), summary)
-    }
-
-    /// Creates the output subfolder `dir` (rank 0; the outcome is shared). Collective.
-    pub fn create_dir(&self, dir: &std::path::Path) -> Result<(), String> {
-        let made = if self.rank == 0 { std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display())) } else { Ok(()) };
-        collective::agree(&self.world, made)
-    }
-
-    /// Writes summary.json into `dir` (atomically; see [`Context::write_summary`]).
-    pub fn write_summary_to(&self, dir: &std::path::Path, summary: &serde_json::Value) -> Result<(), String> {
-        let path = dir.join("summary.json");
-        let text = serde_json::to_string_pretty(summary).map_err(|e| e.to_string())?;
-        crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        self.log(format!("wrote {}", path.display()));
-        Ok(())
-    }
 }
 
 /// Runs the program on every rank; returns the process exit code. Errors are printed by
@@ -122,6 +81,17 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
         }
     };
     crate::interrupt::install();
+    match crate::ehl_options::read(crate::petsc::comm_world()) {
+        Ok(o) => {
+            if let Some(font) = &o.plot_font {
+                crate::output::plot::set_font_file(font);
+            }
+        }
+        Err(e) => {
+            eprintln!("ehl-petsc: error: cannot read the -ehl_ options: {e}");
+            return 3;
+        }
+    }
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {

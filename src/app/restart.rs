@@ -8,6 +8,7 @@
 //! pressure. Everything is read and checked before the output folder is touched.
 use crate::case::Scene;
 use crate::mesh::{ContactLocator, Mesh};
+use crate::output::summary::{DrySummary, Summary};
 use std::path::{Path, PathBuf};
 
 /// Nodal pressure on the contact face: `x_m,z_m,p_pa`, one row per contact node in the
@@ -44,13 +45,15 @@ impl EarlierRun {
         let err = |what: String| format!("--start-from {}: {what}", dir.display());
         let summary_path = dir.join("summary.json");
         let text = std::fs::read_to_string(&summary_path).map_err(|e| err(format!("cannot read {}: {e} (the folder of a converged lubricated run is expected)", summary_path.display())))?;
-        let summary: serde_json::Value = serde_json::from_str(&text).map_err(|e| err(format!("{} is not valid JSON: {e}", summary_path.display())))?;
-        let scene: Scene = serde_json::from_value(summary["scene"].clone()).map_err(|e| err(format!("{} holds no scene this version can read: {e}", summary_path.display())))?;
-        if scene.effects.lubrication != crate::case::LubricationModel::Reynolds {
-            return Err(err("the earlier run is a dry (Hertz) run: it has no film to start from".into()));
+        let summary = match Summary::from_json(&text) {
+            Ok(s) => s,
+            Err(_) if serde_json::from_str::<DrySummary>(&text).is_ok() => return Err(err("the earlier run is a dry (Hertz) run: it has no film to start from".into())),
+            Err(e) => return Err(err(format!("{} is not the summary of a lubricated run this version can read: {e}", summary_path.display()))),
+        };
+        let (scene, hc_m, half) = (summary.scene, summary.film.hc_m, summary.solver.half_domain);
+        if !hc_m.is_finite() {
+            return Err(err(format!("{} has no finite film.hc_m", summary_path.display())));
         }
-        let hc_m = summary["film"]["hc_m"].as_f64().ok_or_else(|| err(format!("{} has no film.hc_m", summary_path.display())))?;
-        let half = summary["solver"]["half_domain"].as_bool().unwrap_or_else(|| scene.uses_half_domain());
         let mesh = if scene.effects.elasticity == crate::case::ElasticityModel::Rigid {
             crate::mesh::face::face_mesh(&super::dry::mesh_spec(&scene, half))?
         } else {

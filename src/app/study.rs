@@ -209,7 +209,7 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
         .and_then(|sol| collective::agree(&ctx.world, post_point(ctx, &sc, &setup, &sol, solver.condensation_s, &dir)).map(|r| (sol, r)));
         let rss_mb = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
         let level = match solved {
-            Ok((sol, r)) => Level { failed: None, h, n_u, n_p, its: sol.newton_total, mesh_s: setup.mesh_s, setup_s: solver.condensation_s.unwrap_or(sol.assembly_s), coupling: solver.coupling(), newton_s: sol.solve_s, total_s: t0.elapsed().as_secs_f64(), rss_mb, r },
+            Ok((sol, r)) => Level { failed: None, h, n_u, n_p, its: sol.newton_total, mesh_s: setup.mesh_s, setup_s: solver.condensation_s.unwrap_or(sol.assembly_s), coupling: solver.coupling().name(), newton_s: sol.solve_s, total_s: t0.elapsed().as_secs_f64(), rss_mb, r },
             Err(e) => {
                 // A level too coarse for the load fails honestly: recorded, skipped, the
                 // ladder goes on.
@@ -220,7 +220,7 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
                 if crate::interrupt::agreed() != 0 {
                     return Err(e);
                 }
-                Level { failed: Some(e), h, n_u, n_p, its: 0, mesh_s: setup.mesh_s, setup_s: solver.condensation_s.unwrap_or(0.0), coupling: solver.coupling(), newton_s: 0.0, total_s: t0.elapsed().as_secs_f64(), rss_mb, r: PointResult::default() }
+                Level { failed: Some(e), h, n_u, n_p, its: 0, mesh_s: setup.mesh_s, setup_s: solver.condensation_s.unwrap_or(0.0), coupling: solver.coupling().name(), newton_s: 0.0, total_s: t0.elapsed().as_secs_f64(), rss_mb, r: PointResult::default() }
             }
         };
         if level.failed.is_none() {

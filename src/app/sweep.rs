@@ -41,10 +41,10 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
         let dir = ctx.out_dir.join(format!("point_{:03}", k + 1));
         ctx.create_dir(&dir)?;
         let mut its = 0;
-        // Test hook (fault injection): EHL_FAIL_POINT=k makes point k fail as a
+        // Test hook (fault injection): -ehl_fail_point k makes point k fail as a
         // non-converged Newton would, to test that the sweep goes on and ends non-zero.
-        let injected = std::env::var("EHL_FAIL_POINT").ok().and_then(|v| v.parse::<usize>().ok()) == Some(k + 1);
-        let solved = if injected { Err("injected failure (EHL_FAIL_POINT)".to_string()) } else { solver.solve(ctx, p, prev.as_deref()) };
+        let injected = crate::ehl_options::get().fail_point == Some(k + 1);
+        let solved = if injected { Err("injected failure (-ehl_fail_point)".to_string()) } else { solver.solve(ctx, p, prev.as_deref()) };
         let result = match solved {
             Ok(sol) => {
                 its = sol.newton_total;

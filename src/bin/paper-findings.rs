@@ -7,7 +7,7 @@
 //! output folders to a table of hc, hm, fx, fz (the R_D study). A finding the model does
 //! not reproduce is printed as DIFFERS with its numbers (the model is not bent to fit);
 //! the exit code is non-zero only when an output is missing.
-use serde_json::Value;
+use ehl_petsc::output::summary::Summary;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -29,12 +29,13 @@ fn f(row: &HashMap<String, String>, key: &str) -> f64 {
     row.get(key).and_then(|v| v.parse().ok()).unwrap_or(f64::NAN)
 }
 
-fn summary(dir: &Path) -> Res<Value> {
-    serde_json::from_str(&read(&dir.join("summary.json"))?).map_err(|e| e.to_string())
+fn summary(dir: &Path) -> Res<Summary> {
+    Summary::read(dir)
 }
 
-fn num(v: &Value, path: &str) -> f64 {
-    path.split('.').fold(v, |c, k| &c[k]).as_f64().unwrap_or(f64::NAN)
+/// Friction coefficients (fx, fz) of a run, NaN without a friction model.
+fn friction(s: &Summary) -> (f64, f64) {
+    s.friction.as_ref().map_or((f64::NAN, f64::NAN), |f| (f.fx, f.fz))
 }
 
 /// Linear interpolation of column `yc` at `xv` of column `xc` (rows sorted by xc).
@@ -119,7 +120,7 @@ fn figs_4_6(dir: &Path) -> Res<()> {
     }
     // 2: the profile on x = 0.
     println!();
-    let a = num(&summary(&s.point_dir(ues[0], 90.0, 0.0).ok_or("no lambda = 90 point")?)?, "hertz.a_m");
+    let a = summary(&s.point_dir(ues[0], 90.0, 0.0).ok_or("no lambda = 90 point")?)?.hertz.a_m;
     let mut asym = Vec::new();
     for &u in &ues {
         let prof = |l: f64| -> Res<Vec<HashMap<String, String>>> { csv(&s.point_dir(u, l, 0.0).ok_or(format!("no point Ue {u} lambda {l}"))?.join("profile_x0.csv")) };
@@ -141,7 +142,7 @@ fn figs_4_6(dir: &Path) -> Res<()> {
         }
         // 3: pressure not significantly changed by spin.
         let p05 = prof(0.5)?;
-        let ph = num(&summary(&s.point_dir(u, 90.0, 0.0).unwrap())?, "hertz.ph_pa");
+        let ph = summary(&s.point_dir(u, 90.0, 0.0).unwrap())?.hertz.ph_pa;
         let dp = p90.iter().zip(&p05).map(|(r, q)| (f(r, "p_pa") - f(q, "p_pa")).abs()).fold(0.0, f64::max) / ph;
         println!("3.  Ue = {u}: max |p(0.5 deg) - p(90 deg)| on x = 0 = {:.3} p_H, pmax ratio {:.4} (not significantly changed: < 0.1 p_H): {}", dp, s.get(u, 0.5, 0.0, "pmax_pa") / s.get(u, 90.0, 0.0, "pmax_pa"), verdict(dp < 0.1));
     }
@@ -221,7 +222,7 @@ fn cases(c1: &Path, c2: &Path) -> Res<()> {
     println!("## Finding 6 (Figs. 9-11), {} and {}\n", c1.display(), c2.display());
     let stats = |dir: &Path| -> Res<(f64, f64, f64, f64, f64)> {
         let rows = csv(&dir.join("shear_profile.csv"))?;
-        let a = num(&summary(dir)?, "hertz.a_m");
+        let a = summary(dir)?.hertz.a_m;
         let inside: Vec<&HashMap<String, String>> = rows.iter().filter(|r| f(r, "x_m").abs() <= a).collect();
         let tx: Vec<f64> = inside.iter().map(|r| f(r, "tau_yx_pa")).collect();
         let tz: Vec<f64> = inside.iter().map(|r| f(r, "tau_yz_pa")).collect();
@@ -240,7 +241,7 @@ fn cases(c1: &Path, c2: &Path) -> Res<()> {
     // direction: look along the transverse centre line x = 0, inside the contact.
     let transverse = |dir: &Path| -> Res<(f64, f64)> {
         let rows = csv(&dir.join("profile_x0.csv"))?;
-        let a = num(&summary(dir)?, "hertz.a_m");
+        let a = summary(dir)?.hertz.a_m;
         let t: Vec<f64> = rows.iter().filter(|r| f(r, "z_m").abs() <= a).map(|r| f(r, "tau_yx_pa")).collect();
         Ok((t.iter().cloned().fold(f64::INFINITY, f64::min), t.iter().cloned().fold(f64::NEG_INFINITY, f64::max)))
     };
@@ -253,7 +254,7 @@ fn cases(c1: &Path, c2: &Path) -> Res<()> {
     println!("6d. Case 2 tau_yz has both signs on the line, the weaker zone reaching {:.2} MPa", zz2 * 1e-6);
     for (name, d) in [("Case 1", c1), ("Case 2", c2)] {
         let s = summary(d)?;
-        println!("    {name}: hc {:.4} um, hm {:.4} um, fx {:.4}, fz {:.3e}", num(&s, "film.hc_m") * 1e6, num(&s, "film.hm_m") * 1e6, num(&s, "friction.fx"), num(&s, "friction.fz"));
+        println!("    {name}: hc {:.4} um, hm {:.4} um, fx {:.4}, fz {:.3e}", s.film.hc_m * 1e6, s.film.hm_m * 1e6, friction(&s).0, friction(&s).1);
     }
     println!();
     Ok(())
@@ -266,15 +267,15 @@ fn extra(dirs: &[PathBuf]) -> Res<()> {
         println!(
             "| {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.3e} | {} | {:.0} |",
             d.display(),
-            num(&s, "scene.geometry.disc_track_radius"),
-            num(&s, "operating.tilt_angle_deg"),
-            num(&s, "operating.slide_to_roll"),
-            num(&s, "film.hc_m") * 1e6,
-            num(&s, "film.hm_m") * 1e6,
-            num(&s, "friction.fx"),
-            num(&s, "friction.fz"),
-            num(&s, "solver.newton_iterations"),
-            num(&s, "timing.total_s")
+            s.scene.geometry.disc_track_radius,
+            s.operating.tilt_angle_deg,
+            s.operating.slide_to_roll,
+            s.film.hc_m * 1e6,
+            s.film.hm_m * 1e6,
+            friction(&s).0,
+            friction(&s).1,
+            s.solver.newton_iterations,
+            s.timing.total_s
         );
     }
     println!();

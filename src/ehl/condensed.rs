@@ -1,12 +1,16 @@
 //! The EHL system with the elastic block condensed onto the contact face
 //! (see [`crate::solid::condense`]): unknowns P at the Reynolds nodes and H0 only,
-//!   Reynolds:      R(P, H(P, H0)) + penalty(P) = 0,   H = H0 + (X^2 + Z^2)/2 + C P
-//!   load balance:  integral of P - W = 0.
-//! It has the same solution as the monolithic system of [`super::system`] (exact
-//! elimination of U). The Jacobian is dense in P (every pressure deflects every face
-//! node): dR/dP + dR/dH C, assembled row by row into a dense-pattern AIJ matrix that MUMPS
-//! factorises; its size is set by the Reynolds mesh alone, not by the 3D mesh.
-use super::system::{clip_pressure_step, p2_tri_weights, penalty_law, pressure_step_floor, tri_area, EhlParams, Lubricant, CAVITATION_SMOOTHING};
+//!   Reynolds:      R(P, H(P, H0)) + penalty(P) = 0,   H = H0 + (X^2 + Z^2)/2 - C P
+//!   load balance:  integral of P - W = 0,
+//! with U_y = C P the face deflection. It has the same solution as the monolithic system of
+//! [`super::system`] (exact elimination of U). The Jacobian is dense in P (every pressure
+//! deflects every face node): dR/dP - dR/dH C, filled block by block into a dense matrix
+//! (options prefix `condensed_`; ScaLAPACK's LU on 2+ ranks, LAPACK's on one; for rigid
+//! solids a sparse AIJ matrix); its size is set by the Reynolds mesh alone, not by the 3D
+//! mesh.
+use super::system::{clip_pressure_step, penalty_law, pressure_step_floor, EhlParams, Lubricant, CAVITATION_SMOOTHING};
+use super::step::{film_step_limit, FILM_COLLAPSE};
+use crate::fem::p2tri::{p2_tri_weights, tri_area};
 use super::system::EhlProblem;
 use crate::mesh::Mesh;
 use crate::petsc::snes::{Eval, Problem};
@@ -58,14 +62,13 @@ struct Element {
     face: [usize; 6],
     /// The pressure unknowns each of the 6 nodes takes its pressure from, with weights
     /// (unknown -1 or weight 0: none; the Dirichlet edges have no unknown): the node's own
-    /// unknown, or with a P1 pressure the vertices it interpolates.
+    /// unknown with weight 1. Kept as a prolongation T (pressure unknowns to nodal
+    /// pressures) so that another pressure space changes only this table.
     t: [[(i32, f64); 2]; 6],
     verts: [[f64; 2]; 3],
     vel: [[f64; 2]; 3],
     /// Load weights (integral of each pressure basis function over the element).
     w: [f64; 6],
-    /// Linear sub-triangle (P1-iso-P2 pressure): only the first 3 nodes are used.
-    linear: bool,
     /// Touches a row this rank owns.
     mine: bool,
 }
@@ -205,18 +208,13 @@ pub struct CondensedSystem<'a> {
     pub params: EhlParams,
     pub lubricant: Lubricant,
     elements: Vec<Element>,
-    /// Face index of each pressure unknown.
-    p_face: Vec<usize>,
-    /// Nodal area (integral of the P2 or P1 hat function) of each pressure unknown.
+    /// Nodal area (a sixth of each P2 triangle at the node) of each pressure unknown.
     p_area: Vec<f64>,
     /// The block of the dense Jacobian this rank fills (default: its rows, all columns).
     fill: FillBlock,
     /// Rigid gap at each face node.
     gap: Vec<f64>,
     row_scale: Vec<f64>,
-    /// Pseudo-transient term (dt, rho H at the previous pseudo time at each P unknown's
-    /// node): area_j (rho_j H_j - old_j) / dt is added to Reynolds row j. None: steady.
-    pseudo: Option<(f64, Vec<f64>)>,
     pub residual_evals: usize,
     pub jacobian_evals: usize,
     pub step_limits: Vec<f64>,
@@ -239,8 +237,6 @@ impl<'a> CondensedSystem<'a> {
         let (lo, hi) = (layout.ranges[rank], layout.ranges[rank + 1].min(layout.n_p));
         let mut node_area = vec![0.0; comp.rows.len()];
         let mut elements = Vec::new();
-        let linear = crate::reynolds::p1iso_pressure();
-        let p1 = crate::reynolds::p1_pressure();
         let owned = |d: i32| d >= 0 && (d as usize) >= lo && (d as usize) < hi;
         for tri in &mesh.contact_tris {
             let xz = |n: u32| {
@@ -249,42 +245,13 @@ impl<'a> CondensedSystem<'a> {
             };
             let face = tri.map(|n| layout.face_index[n as usize] as usize);
             let p = tri.map(|n| layout.p_index[n as usize]);
-            if linear {
-                for sub in crate::reynolds::P2_SUB_TRIANGLES {
-                    let verts = sub.map(|k| xz(tri[k]));
-                    let area = tri_area(&verts);
-                    let f6: [usize; 6] = std::array::from_fn(|i| face[sub[i.min(2)]]);
-                    let t: [[(i32, f64); 2]; 6] = std::array::from_fn(|i| if i < 3 { [(p[sub[i]], 1.0), (-1, 0.0)] } else { [(-1, 0.0); 2] });
-                    let w: [f64; 6] = std::array::from_fn(|i| if i < 3 { area / 3.0 } else { 0.0 });
-                    for i in 0..3 {
-                        node_area[f6[i]] += area / 3.0;
-                    }
-                    let mut e = Element { face: f6, t, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w, linear: true, mine: false };
-                    e.mine = e.any_dof(owned);
-                    elements.push(e);
-                }
-                continue;
-            }
             let verts = [xz(tri[0]), xz(tri[1]), xz(tri[2])];
             let area = tri_area(&verts);
-            if p1 {
-                // The P1 hat of a vertex integrates to a third of each triangle it touches.
-                for &f in &face[..3] {
-                    node_area[f] += area / 3.0;
-                }
-            } else {
-                for &f in &face {
-                    node_area[f] += area / 6.0;
-                }
+            for &f in &face {
+                node_area[f] += area / 6.0;
             }
-            let t: [[(i32, f64); 2]; 6] = std::array::from_fn(|k| {
-                let mut entries = [(-1, 0.0); 2];
-                for (m, (v, w)) in crate::solid::condense::pressure_of_node(k, p1).enumerate() {
-                    entries[m] = (p[v], w);
-                }
-                entries
-            });
-            let mut e = Element { face, t, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w: p2_tri_weights(area), linear: false, mine: false };
+            let t: [[(i32, f64); 2]; 6] = std::array::from_fn(|k| [(p[k], 1.0), (-1, 0.0)]);
+            let mut e = Element { face, t, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w: p2_tri_weights(area), mine: false };
             e.mine = e.any_dof(owned);
             elements.push(e);
         }
@@ -301,12 +268,10 @@ impl<'a> CondensedSystem<'a> {
             params,
             lubricant,
             elements,
-            p_face,
             p_area,
             fill,
             gap,
             row_scale,
-            pseudo: None,
             residual_evals: 0,
             jacobian_evals: 0,
             step_limits: Vec::new(),
@@ -364,19 +329,9 @@ impl<'a> CondensedSystem<'a> {
         self.lubricant.fluid(self.params.lambda_bar)
     }
 
-    /// Residual and Jacobian of one element (P2, or a linear sub-triangle padded to 6 nodes).
+    /// Residual and Jacobian of one P2 element.
     fn eval(&self, e: &Element, p: &[f64; 6], h: &[f64; 6], fluid: &Fluid) -> ElementOut {
-        if !e.linear {
-            return reynolds_element(&e.verts, p, h, &e.vel, fluid, &self.params.stabilisation);
-        }
-        let (r, dp, dh) = crate::reynolds::p1::reynolds_p1_element_stab(&e.verts, &[p[0], p[1], p[2]], &[h[0], h[1], h[2]], &e.vel, fluid, &self.params.stabilisation);
-        let mut out = ElementOut { r: [0.0; 6], dr_dp: [[0.0; 6]; 6], dr_dh: [[0.0; 6]; 6] };
-        for i in 0..3 {
-            out.r[i] = r[i];
-            out.dr_dp[i][..3].copy_from_slice(&dp[i]);
-            out.dr_dh[i][..3].copy_from_slice(&dh[i]);
-        }
-        out
+        reynolds_element(&e.verts, p, h, &e.vel, fluid, &self.params.stabilisation)
     }
 
     /// The element's 6 nodal pressures (T P on the element).
@@ -455,36 +410,9 @@ impl<'a> CondensedSystem<'a> {
         }
         Ok(())
     }
-
-    /// Developer aid (EHL_DEBUG): appends the iterate's centre lines to /tmp/ehl_debug_lines.csv.
-    fn debug_dump(&self, x: &[f64], h: &[f64]) {
-        use std::io::Write;
-        let Some(mesh) = self.debug_mesh else { return };
-        let mut f = std::fs::OpenOptions::new().create(true).append(true).open("/tmp/ehl_debug_lines.csv").unwrap();
-        let it = self.step_limits.len();
-        for (i, &n) in self.comp.rows.iter().enumerate() {
-            let c = mesh.nodes[n as usize];
-            if c[2].abs() < 1e-9 || c[0].abs() < 1e-9 {
-                let j = self.layout.p_index[n as usize];
-                let p = if j >= 0 { x[j as usize] } else { 0.0 };
-                let _ = writeln!(f, "{it},{},{},{},{}", c[0], c[2], p, h[i]);
-            }
-        }
-    }
 }
 
 impl EhlProblem for CondensedSystem<'_> {
-    /// Switches the pseudo-transient term on with step `dt`, the old state being `x`
-    /// (pseudo-transient continuation: the steady solution does not depend on it).
-    fn set_pseudo_time(&mut self, dt: Option<f64>, x: &[f64]) -> bool {
-        self.pseudo = dt.map(|dt| {
-            let h = self.film(x);
-            let old = self.p_face.iter().enumerate().map(|(j, &f)| (self.lubricant.rho)(x[j]).0 * h[f]).collect();
-            (dt, old)
-        });
-        true
-    }
-
     fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64) {
         self.params.set_operating(lambda_bar, penalty);
         self.lubricant = lubricant;
@@ -526,26 +454,6 @@ impl EhlProblem for CondensedSystem<'_> {
     }
 }
 
-/// Fraction to the boundary for the film: the largest s <= 1 such that the step
-/// H - s dH keeps at least `keep` H at every node with H > 0, and the node that binds (None
-/// when the full step is allowed).
-pub fn film_step_limit(h: &[f64], dh: &[f64], keep: f64) -> (f64, Option<usize>) {
-    let mut s: f64 = 1.0;
-    let mut binding = None;
-    for (k, (&hk, &dk)) in h.iter().zip(dh).enumerate() {
-        if dk > 0.0 && hk > 0.0 && (1.0 - keep) * hk / dk < s {
-            s = (1.0 - keep) * hk / dk;
-            binding = Some(k);
-        }
-    }
-    (s, binding)
-}
-
-/// Dimensionless film H = h R / a^2 below which a node counts as closed while Newton keeps
-/// pushing it down: 1e-8 a^2/R is a fraction of a picometre on every scene here (a^2/R is
-/// 10-100 um), far below a molecule, so no lubricant film is left to compute.
-pub const FILM_COLLAPSE: f64 = 1e-8;
-
 impl Problem for CondensedSystem<'_> {
     fn residual(&mut self, x: &[f64], f: &Vector) -> Result<Eval> {
         self.residual_evals += 1;
@@ -572,11 +480,6 @@ impl Problem for CondensedSystem<'_> {
         for j in self.owned_p() {
             r[j - lo] += self.params.penalty * self.p_area[j] * penalty_law(x[j]).0;
         }
-        if let Some((dt, old)) = &self.pseudo {
-            for j in self.owned_p() {
-                r[j - lo] += self.p_area[j] * ((self.lubricant.rho)(x[j]).0 * h[self.p_face[j]] - old[j]) / dt;
-            }
-        }
         for (i, v) in r.iter_mut().enumerate() {
             *v *= self.row_scale[lo + i];
         }
@@ -587,13 +490,13 @@ impl Problem for CondensedSystem<'_> {
                 None => self.load(x) - self.params.load,
             };
         }
-        if std::env::var_os("EHL_DEBUG").is_some() {
+        if crate::ehl_options::get().monitor {
             if let Some(mesh) = self.debug_mesh {
                 let np = self.layout.n_p;
                 let mut order: Vec<usize> = (0..r.len()).filter(|&i| lo + i < np).collect();
                 order.sort_by(|&a, &b| r[b].abs().partial_cmp(&r[a].abs()).unwrap());
                 let norm: f64 = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-                let mut msg = format!("EHL_DEBUG rank {} |r| = {norm:.3e}; worst:", self.rank);
+                let mut msg = format!("ehl_monitor: rank {} |r| = {norm:.3e}; worst:", self.rank);
                 for &i in order.iter().take(4) {
                     let n = self.comp.cols[lo + i];
                     let c = mesh.nodes[n as usize];
@@ -622,14 +525,10 @@ impl Problem for CondensedSystem<'_> {
 
     fn limit_step(&mut self, x: &[f64], y: &[f64]) -> Result<f64> {
         const FILM_KEEP: f64 = 0.2;
-        let h = self.film(x);
-        if std::env::var_os("EHL_NO_LIMIT").is_some() {
-            if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
-                self.step_limits.push(1.0);
-                self.debug_dump(x, &h);
-            }
+        if !crate::ehl_options::get().film_limiter {
             return Ok(1.0);
         }
+        let h = self.film(x);
         let dh0 = y[self.layout.h0()];
         // x_new = x - y: H_new = H - (dh0 - duy)
         let dh: Vec<f64> = self.comp.apply(&y[..self.layout.n_p]).iter().map(|duy| dh0 - duy).collect();
@@ -642,18 +541,17 @@ impl Problem for CondensedSystem<'_> {
             self.collapse = Some(self.face_xz(k).unwrap_or([f64::NAN; 2]));
             return Ok(0.0);
         }
-        if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
+        if crate::ehl_options::get().monitor && self.rank == 0 {
             let k = (0..h.len()).min_by(|&a, &b| h[a].partial_cmp(&h[b]).unwrap()).unwrap();
             let at = self.face_xz(k).map(|c| format!(" (X, Z) = ({:.3}, {:.3})", c[0], c[1])).unwrap_or_default();
-            eprintln!("EHL_DEBUG limiter {s:.3e}; H0 = {:.4e} dH0 = {dh0:.3e}; min H = {:.3e} at node {}{at}", x[self.layout.h0()], h[k], self.comp.rows[k]);
-            self.debug_dump(x, &h);
+            eprintln!("ehl_monitor: limiter {s:.3e}; H0 = {:.4e} dH0 = {dh0:.3e}; min H = {:.3e} at node {}{at}", x[self.layout.h0()], h[k], self.comp.rows[k]);
         }
         Ok(s)
     }
 
     fn jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
         self.jacobian_evals += 1;
-        if self.comp.is_rigid() && self.pseudo.is_none() {
+        if self.comp.is_rigid() {
             return self.jacobian_rigid(x, j);
         }
         let np = self.layout.n_p;
@@ -701,22 +599,6 @@ impl Problem for CondensedSystem<'_> {
             if let Some(c) = diag {
                 row[c] += self.params.penalty * area * penalty_slope(x[jn]);
             }
-            if let Some((dt, _)) = &self.pseudo {
-                let f = self.p_face[jn];
-                let (rho, drho) = (self.lubricant.rho)(x[jn]);
-                // d(rho H)/dP_k = rho' H delta_jk - rho C[f, k]; d/dH0 = rho.
-                if let Some(c) = diag {
-                    row[c] += area * drho * h[f] / dt;
-                }
-                if !self.comp.is_rigid() {
-                    for (a, c) in row.iter_mut().zip(fb.c_row(self.comp, f)) {
-                        *a -= area * rho * c / dt;
-                    }
-                }
-                if let Some(c) = h0_col {
-                    row[c] += area * rho / dt;
-                }
-            }
             let s = self.row_scale[jn];
             row.iter_mut().for_each(|v| *v *= s);
         }
@@ -737,23 +619,5 @@ impl Problem for CondensedSystem<'_> {
         let cols: Vec<i32> = fb.cols.iter().map(|&c| c as i32).collect();
         j.set_values(&rows, &cols, &buf)?;
         Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{film_step_limit, FILM_COLLAPSE};
-
-    #[test]
-    fn the_film_limiter_keeps_a_fifth_and_names_the_binding_node() {
-        // Node 1 would lose twice its film: s = 0.8 * 5e-9 / 1e-8 = 0.4 leaves 1e-9 there.
-        let (h, dh) = ([1e-2, 5e-9, 1.0], [1e-3, 1e-8, -1.0]);
-        let (s, k) = film_step_limit(&h, &dh, 0.2);
-        assert!((s - 0.4).abs() < 1e-15 && k == Some(1));
-        assert!((h[1] - s * dh[1] - 0.2 * h[1]).abs() < 1e-24);
-        // That node's film is below the collapse threshold: the solver would stop here.
-        assert!(h[1] < FILM_COLLAPSE);
-        // A step that thins no film by more than 80 % is taken whole.
-        assert_eq!(film_step_limit(&h, &[1e-3, 1e-9, 0.5], 0.2), (1.0, None));
     }
 }

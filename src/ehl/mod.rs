@@ -4,5 +4,6 @@ pub mod layout;
 pub mod prealloc;
 pub mod system;
 pub mod condensed;
+pub mod step;
 pub mod driver;
 pub mod post;

@@ -1,7 +1,7 @@
 //! Film and pressure quantities from a converged EHL state (dimensionless, on every rank):
 //! central and minimum film thickness, maximum pressure, load balance and profiles.
 use super::layout::Layout;
-use super::system::{p2_tri_weights, tri_area};
+use crate::fem::p2tri::{p2_tri_weights, tri_area};
 use crate::mesh::{ContactLocator, Mesh};
 
 /// Nodal pressure and film of one contact triangle (6 P2 nodes).

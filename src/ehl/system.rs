@@ -6,6 +6,7 @@
 //! Only the Reynolds rows depend on the iterate, so after the first assembly the Jacobian
 //! keeps its U and H0 rows and only the P rows are zeroed and refilled.
 use super::layout::Layout;
+use crate::fem::p2tri::{p2_tri_mass, p2_tri_weights, tri_area};
 use crate::mesh::{Mesh, Partition};
 use crate::petsc::snes::{Eval, Problem};
 use crate::petsc::{ffi, Matrix, Result, Vector};
@@ -14,39 +15,12 @@ use crate::reynolds::element::{reynolds_element, Fluid, Stabilisation};
 use crate::solid::dofmap::DofMap;
 use mpi::topology::SimpleCommunicator;
 
-/// Mass matrix of a straight P2 triangle, integral of N_i N_j (closed form, area/180 * ...).
-pub fn p2_tri_mass(area: f64) -> [[f64; 6]; 6] {
-    const M: [[f64; 6]; 6] = [
-        [6., -1., -1., 0., -4., 0.],
-        [-1., 6., -1., 0., 0., -4.],
-        [-1., -1., 6., -4., 0., 0.],
-        [0., 0., -4., 32., 16., 16.],
-        [-4., 0., 0., 16., 32., 16.],
-        [0., -4., 0., 16., 16., 32.],
-    ];
-    M.map(|row| row.map(|m| m * area / 180.0))
-}
-
-/// Signed-area-free triangle area in the (X, Z) plane.
-pub fn tri_area(v: &[[f64; 2]; 3]) -> f64 {
-    0.5 * ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1])).abs()
-}
-
-/// Integral of the P2 basis functions over a triangle: 0 at vertices, area/3 at midpoints.
-pub fn p2_tri_weights(area: f64) -> [f64; 6] {
-    [0.0, 0.0, 0.0, area / 3.0, area / 3.0, area / 3.0]
-}
-
 pub use crate::reynolds::cavitation::{clip_pressure_step, penalty_law, CAVITATION_SMOOTHING, PRESSURE_STEP_FLOOR};
 
-/// The floor of a Newton step's nodal pressure ([`PRESSURE_STEP_FLOOR`]); the developer
-/// switch `EHL_P_FLOOR` sets another value, or `off`.
+/// The floor of a Newton step's nodal pressure ([`PRESSURE_STEP_FLOOR`]); the options
+/// `-ehl_pressure_step_floor VALUE` and `-ehl_pressure_step_clip false` change it.
 pub fn pressure_step_floor() -> Option<f64> {
-    match std::env::var("EHL_P_FLOOR") {
-        Ok(v) if v == "off" => None,
-        Ok(v) => Some(v.parse().expect("EHL_P_FLOOR: a number or off")),
-        Err(_) => Some(PRESSURE_STEP_FLOOR),
-    }
+    crate::ehl_options::get().pressure_step_floor
 }
 
 /// Lubricant laws in dimensionless form: eta_bar(P), rho_bar(P) with their P-derivatives.
@@ -128,7 +102,7 @@ pub struct EhlSystem<'a> {
     /// Step-limiter factors applied at each Newton step (1 = full Newton step).
     pub step_limits: Vec<f64>,
     /// Where (X, Z) the film closed in the last solve, if it did (see
-    /// [`super::condensed::FILM_COLLAPSE`]).
+    /// [`super::step::FILM_COLLAPSE`]).
     pub collapse: Option<[f64; 2]>,
     /// Constant scale of each Reynolds row (indexed by global row), 1 by default; see
     /// [`EhlSystem::scale_rows`].
@@ -277,12 +251,6 @@ pub trait EhlProblem: Problem {
     /// sizes differ by ten orders of magnitude (eps ~ 1e4 at the inlet, ~1e-9 in the
     /// contact); scaled, the residual norm that the line search watches weighs them alike.
     fn scale_rows(&mut self, x: &[f64]) -> Result<()>;
-    /// Pseudo-transient continuation: adds (rho H - (rho H)_old)/dt to the Reynolds rows,
-    /// the old state being `x`; `None` restores the steady problem. Returns false if the
-    /// problem does not support it.
-    fn set_pseudo_time(&mut self, _dt: Option<f64>, _x: &[f64]) -> bool {
-        false
-    }
     /// Replaces the entrainment velocity field (continuation in the tilt angle). Returns
     /// false if the problem does not support it.
     fn set_velocity(&mut self, _velocity: Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync>) -> bool {
@@ -355,7 +323,7 @@ impl Problem for EhlSystem<'_> {
                 break;
             }
         }
-        let any_bad = crate::app::collective::max_f64(self.world, if bad.is_some() { 1.0 } else { 0.0 });
+        let any_bad = crate::collective::max_f64(self.world, if bad.is_some() { 1.0 } else { 0.0 });
         if any_bad > 0.0 {
             return Ok(Eval::Domain(bad.unwrap_or_else(|| "non-positive film on another rank".into())));
         }
@@ -393,7 +361,7 @@ impl Problem for EhlSystem<'_> {
                 f.set_values(&[d], &[self.scale_of(d) * self.params.penalty * area * v], true)?;
             }
         }
-        if std::env::var_os("EHL_DEBUG").is_some() {
+        if crate::ehl_options::get().monitor {
             let mut maxr: f64 = 0.0;
             let mut at = 0;
             let fluid2 = self.fluid();
@@ -405,12 +373,12 @@ impl Problem for EhlSystem<'_> {
                 if m > maxr { maxr = m; at = k; }
             }
             let e = &self.elements[at];
-            eprintln!("EHL_DEBUG max |R_reynolds| = {maxr:.3e} at element {:?} P = {:?} H = {:?}", e.verts, self.element_pressure(x, e), self.element_film(x, e));
-            eprintln!("EHL_DEBUG max |KU| = {:.3e}, h0 = {}", ku.iter().fold(0.0f64, |a, b| a.max(b.abs())), x[self.layout.h0 as usize]);
+            eprintln!("ehl_monitor: max |R_reynolds| = {maxr:.3e} at element {:?} P = {:?} H = {:?}", e.verts, self.element_pressure(x, e), self.element_film(x, e));
+            eprintln!("ehl_monitor: max |KU| = {:.3e}, h0 = {}", ku.iter().fold(0.0f64, |a, b| a.max(b.abs())), x[self.layout.h0 as usize]);
         }
         let target = if self.rank == self.layout.ranges.len() - 2 { -self.params.load } else { 0.0 };
         f.set_values(&[self.layout.h0], &[load_part + target], true)?;
-        if std::env::var_os("EHL_DEBUG").is_some() {
+        if crate::ehl_options::get().monitor {
             f.assemble()?;
             let all = f.gather_all()?;
             if self.rank == 0 {
@@ -427,7 +395,7 @@ impl Problem for EhlSystem<'_> {
                     }
                 }
                 let c = self.mesh.nodes[worst_at];
-                eprintln!("EHL_DEBUG |F_U| = {:.3e} |F_P| = {:.3e} |F_H0| = {:.3e}; worst P row {:.3e} at ({:.3}, {:.3}) P = {:.4} H = {:.4}",
+                eprintln!("ehl_monitor: |F_U| = {:.3e} |F_P| = {:.3e} |F_H0| = {:.3e}; worst P row {:.3e} at ({:.3}, {:.3}) P = {:.4} H = {:.4}",
                     nu.sqrt(), np.sqrt(), all[self.layout.h0 as usize].abs(), worst, c[0], c[2], x[self.layout.p[worst_at] as usize],
                     self.layout.film(self.mesh, x, worst_at as u32));
             }
@@ -448,15 +416,15 @@ impl Problem for EhlSystem<'_> {
                 n += 1;
             }
         }
-        if n > 0 && std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
-            eprintln!("EHL_DEBUG pressure step clipped at {n} nodes (floor {floor})");
+        if n > 0 && crate::ehl_options::get().monitor && self.rank == 0 {
+            eprintln!("ehl_monitor: pressure step clipped at {n} nodes (floor {floor})");
         }
         Ok(n)
     }
 
     fn limit_step(&mut self, x: &[f64], y: &[f64]) -> Result<f64> {
         const FILM_KEEP: f64 = 0.2;
-        if std::env::var_os("EHL_NO_LIMIT").is_some() {
+        if !crate::ehl_options::get().film_limiter {
             return Ok(1.0);
         }
         let dh0 = y[self.layout.h0 as usize];
@@ -464,7 +432,7 @@ impl Problem for EhlSystem<'_> {
         let h: Vec<f64> = nodes.iter().map(|&n| self.layout.film(self.mesh, x, n)).collect();
         // x_new = x - y: H_new = H - (dh0 - duy)
         let dh: Vec<f64> = nodes.iter().map(|&n| dh0 - self.layout.uy(y, n)).collect();
-        let (s, binding) = super::condensed::film_step_limit(&h, &dh, FILM_KEEP);
+        let (s, binding) = super::step::film_step_limit(&h, &dh, FILM_KEEP);
         let at = binding.map(|k| {
             let c = self.mesh.nodes[nodes[k] as usize];
             [c[0], c[2], h[k], dh[k]]
@@ -472,13 +440,13 @@ impl Problem for EhlSystem<'_> {
         self.step_limits.push(s);
         // As in the condensed system: Newton keeps pushing one nodal film through zero, so
         // stop this solve (a zero step fails the line search at once).
-        if let Some(k) = binding.filter(|&k| h[k] < super::condensed::FILM_COLLAPSE) {
+        if let Some(k) = binding.filter(|&k| h[k] < super::step::FILM_COLLAPSE) {
             let c = self.mesh.nodes[nodes[k] as usize];
             self.collapse = Some([c[0], c[2]]);
             return Ok(0.0);
         }
-        if std::env::var_os("EHL_DEBUG").is_some() && self.rank == 0 {
-            eprintln!("EHL_DEBUG step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e} binding at X,Z,H,dH = {at:?}", x[self.layout.h0 as usize]);
+        if crate::ehl_options::get().monitor && self.rank == 0 {
+            eprintln!("ehl_monitor: step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e} binding at X,Z,H,dH = {at:?}", x[self.layout.h0 as usize]);
         }
         Ok(s)
     }

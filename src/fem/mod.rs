@@ -10,8 +10,10 @@
 //! - Vector-field element DOFs are node-major: `[u_x0, u_y0, u_z0, u_x1, ...]` (30 per tet).
 //!
 //! Submodules
-//! - [`quadrature`]: symmetric positive rules on the reference tet/triangle, collapsed Gauss.
-//! - [`p2tet`], [`p2tri`]: P2 shape functions, gradients, evaluation.
+//! - [`quadrature`]: symmetric positive rules on the reference tet/triangle, collapsed Gauss;
+//!   the degree-6 triangle rule also in barycentric form ([`quadrature::DUNAVANT6`]).
+//! - [`p2tet`], [`p2tri`]: P2 shape functions, gradients, evaluation; the physical P2
+//!   triangle of the contact face ([`p2tri::P2Triangle`]), its mass matrix and area.
 //! - [`geometry`]: affine maps (`J`, `det J`, `J^{-T}`, physical gradients).
 //! - [`elasticity`]: Lamé parameters and the isotropic elasticity stiffness kernel.
 //! - [`loads`]: body-force and contact-pressure load vectors.

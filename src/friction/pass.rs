@@ -9,11 +9,27 @@
 //! zone included: the model has no film-fraction, so the full film is sheared there; its
 //! share is small because the viscosity is low and the film thick).
 use super::shear::{disc_shear_stress, FilmPoint, ShearLaw};
-use crate::ehl::post::FieldsOnFace;
 use crate::fem::geometry::AffineTri;
 use crate::fem::p2tri::{p2_tri_basis_bary, p2_tri_grads_bary};
 use crate::mesh::spec::Rect;
+use crate::mesh::Mesh;
 use crate::physics::Kinematics;
+
+/// The converged solution on the contact face as the friction pass reads it
+/// (dimensionless): nodal pressure and film, and where a point lies.
+pub trait FaceSolution {
+    /// The mesh whose contact face carries the solution.
+    fn mesh(&self) -> &Mesh;
+    /// Nodal pressure P (0 on the Dirichlet edges).
+    fn p_node(&self, n: u32) -> f64;
+    /// Nodal film H.
+    fn h_node(&self, n: u32) -> f64;
+    /// Whether the mesh is the half domain z <= 0 of a symmetric scene.
+    fn half(&self) -> bool;
+    /// The contact triangle containing (x, z) and the point's barycentric coordinates (on a
+    /// half domain, of the mirror image of a point z > 0).
+    fn locate(&self, x: f64, z: f64) -> Option<(usize, [f64; 3])>;
+}
 
 /// What the pass needs besides the fields: the shear law, the viscosity law, the surface
 /// velocities and the scales that turn the dimensionless fields into SI units.
@@ -52,11 +68,11 @@ pub struct FrictionResult {
 }
 
 /// Whether contact triangle `t` lies in Omega_c (its centroid does).
-fn in_rect(fields: &FieldsOnFace, t: usize, r: &Rect) -> bool {
-    let tri = fields.mesh.contact_tris[t];
+fn in_rect(fields: &dyn FaceSolution, t: usize, r: &Rect) -> bool {
+    let tri = fields.mesh().contact_tris[t];
     let (mut x, mut z) = (0.0, 0.0);
     for &n in &tri[..3] {
-        let c = fields.mesh.nodes[n as usize];
+        let c = fields.mesh().nodes[n as usize];
         x += c[0] / 3.0;
         z += c[2] / 3.0;
     }
@@ -73,8 +89,8 @@ struct TriFields {
 }
 
 impl TriFields {
-    fn new(fields: &FieldsOnFace, t: usize) -> Self {
-        let mesh = fields.mesh;
+    fn new(fields: &dyn FaceSolution, t: usize) -> Self {
+        let mesh = fields.mesh();
         let tri = mesh.contact_tris[t];
         let v: [[f64; 2]; 3] = std::array::from_fn(|i| {
             let c = mesh.nodes[tri[i] as usize];
@@ -107,9 +123,9 @@ impl TriFields {
 }
 
 /// Runs the pass over Omega_c (serial; call it on one rank).
-pub fn friction_pass(fields: &FieldsOnFace, s: &FrictionSetup) -> Result<FrictionResult, String> {
+pub fn friction_pass(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<FrictionResult, String> {
     let t0 = std::time::Instant::now();
-    let mesh = fields.mesh;
+    let mesh = fields.mesh();
     let (mut fx_n, mut fz_n, mut tau_max) = (0.0, 0.0, 0.0f64);
     let mut nodal = Vec::new();
     const NODES: [[f64; 3]; 6] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]];
@@ -118,8 +134,8 @@ pub fn friction_pass(fields: &FieldsOnFace, s: &FrictionSetup) -> Result<Frictio
             continue;
         }
         let tf = TriFields::new(fields, t);
-        let area = crate::ehl::system::tri_area(&tf.v) * s.a * s.a;
-        for q in crate::reynolds::quadrature::DUNAVANT6.iter() {
+        let area = crate::fem::p2tri::tri_area(&tf.v) * s.a * s.a;
+        for q in crate::fem::quadrature::DUNAVANT6.iter() {
             let tau = tf.stress(s, q.l)?;
             fx_n += q.w * area * tau[0];
             fz_n += q.w * area * tau[1];
@@ -142,7 +158,7 @@ pub fn friction_pass(fields: &FieldsOnFace, s: &FrictionSetup) -> Result<Frictio
 
 /// The shear stress on the disc at (x, z) (units of a), or None outside the contact face.
 /// On a half domain a point z > 0 takes its mirror image's stress with tau_yz negated.
-pub fn stress_at(fields: &FieldsOnFace, s: &FrictionSetup, x: f64, z: f64) -> Option<Result<[f64; 2], String>> {
+pub fn stress_at(fields: &dyn FaceSolution, s: &FrictionSetup, x: f64, z: f64) -> Option<Result<[f64; 2], String>> {
     let (t, b) = fields.locate(x, z)?;
     let mirrored = fields.half() && z > 0.0;
     Some(TriFields::new(fields, t).stress(s, b).map(|v| if mirrored { [v[0], -v[1]] } else { v }))

@@ -2,6 +2,7 @@
 //! VTU fields for ParaView and PNG plots.
 pub mod csv;
 pub mod plot;
+pub mod summary;
 pub mod vtu;
 
 use std::io::Write;

@@ -57,3 +57,62 @@ pub fn get_string(name: &str) -> Result<Option<String>> {
     }
     Ok(Some(unsafe { std::ffi::CStr::from_ptr(buf.as_ptr()) }.to_string_lossy().into_owned()))
 }
+
+/// A group of options read with PETSc's `PetscOptionsBegin`/`End`: each query returns the
+/// value from the database (marking the option used, so `-options_left` does not list it)
+/// and, under `-help`, prints the option with its default and description. Collective on
+/// `comm`.
+pub struct Group {
+    items: Box<super::ffi::PetscOptionItems>,
+}
+
+impl Group {
+    /// Starts a group titled `title` (the heading `-help` prints) in manual section `section`.
+    pub fn begin(comm: super::ffi::MPI_Comm, title: &str, section: &str) -> Result<Group> {
+        let mut items: Box<super::ffi::PetscOptionItems> = Box::default();
+        // PetscOptionsBegin's loop runs once, with count 1, unless a GUI publishes options.
+        items.count = 1;
+        let (t, s) = (cstr(title), cstr(section));
+        pcall!(super::ffi::PetscOptionsBegin_Private(&mut *items, comm, std::ptr::null(), t.as_ptr(), s.as_ptr()))?;
+        Ok(Group { items })
+    }
+
+    /// A boolean option (`-name`, `-name true|false`).
+    pub fn bool(&mut self, name: &str, help: &str, default: bool) -> Result<bool> {
+        let (n, h, m) = (cstr(name), cstr(help), cstr("EhlOptions"));
+        let mut v: super::ffi::PetscBool = default as super::ffi::PetscBool;
+        pcall!(super::ffi::PetscOptionsBool_Private(&mut *self.items, n.as_ptr(), h.as_ptr(), m.as_ptr(), default as super::ffi::PetscBool, &mut v, std::ptr::null_mut()))?;
+        Ok(v != 0)
+    }
+
+    /// A real option; None if not given.
+    pub fn real(&mut self, name: &str, help: &str, default: f64) -> Result<Option<f64>> {
+        let (n, h, m) = (cstr(name), cstr(help), cstr("EhlOptions"));
+        let (mut v, mut set) = (default, 0 as super::ffi::PetscBool);
+        pcall!(super::ffi::PetscOptionsReal_Private(&mut *self.items, n.as_ptr(), h.as_ptr(), m.as_ptr(), default, &mut v, &mut set))?;
+        Ok((set != 0).then_some(v))
+    }
+
+    /// An integer option; None if not given.
+    pub fn int(&mut self, name: &str, help: &str, default: i32) -> Result<Option<i32>> {
+        let (n, h, m) = (cstr(name), cstr(help), cstr("EhlOptions"));
+        let (mut v, mut set) = (default, 0 as super::ffi::PetscBool);
+        pcall!(super::ffi::PetscOptionsInt_Private(&mut *self.items, n.as_ptr(), h.as_ptr(), m.as_ptr(), default, &mut v, &mut set, i32::MIN, i32::MAX))?;
+        Ok((set != 0).then_some(v))
+    }
+
+    /// A string option; None if not given.
+    pub fn string(&mut self, name: &str, help: &str, default: &str) -> Result<Option<String>> {
+        let (n, h, m, d) = (cstr(name), cstr(help), cstr("EhlOptions"), cstr(default));
+        let mut buf = vec![0 as std::os::raw::c_char; 4096];
+        let mut set: super::ffi::PetscBool = 0;
+        pcall!(super::ffi::PetscOptionsString_Private(&mut *self.items, n.as_ptr(), h.as_ptr(), m.as_ptr(), d.as_ptr(), buf.as_mut_ptr(), buf.len(), &mut set))?;
+        Ok((set != 0).then(|| unsafe { std::ffi::CStr::from_ptr(buf.as_ptr()) }.to_string_lossy().into_owned()))
+    }
+
+    /// Ends the group.
+    pub fn end(mut self) -> Result<()> {
+        pcall!(super::ffi::PetscOptionsEnd_Private(&mut *self.items))?;
+        Ok(())
+    }
+}

@@ -3,8 +3,8 @@
 //! formulas.
 
 use super::dual::Dual;
-use super::p2::P2Triangle;
-use super::quadrature::DUNAVANT6;
+use crate::fem::p2tri::P2Triangle;
+use crate::fem::quadrature::DUNAVANT6;
 
 /// Number of element unknowns differentiated: 6 nodal P then 6 nodal H.
 pub const NDOF: usize = 12;

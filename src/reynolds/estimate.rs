@@ -17,8 +17,8 @@
 
 use super::dual::Dual;
 use super::element::{strong_residual, Fluid, PointFields, Stabilisation, StrongResidual};
-use super::p2::P2Triangle;
-use super::quadrature::DUNAVANT6;
+use crate::fem::p2tri::P2Triangle;
+use crate::fem::quadrature::DUNAVANT6;
 
 type D1 = Dual<1>;
 

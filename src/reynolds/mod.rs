@@ -15,7 +15,7 @@
 //! by its values at the three vertices.
 //!
 //! # Discretisation
-//! Straight P2 triangles ([`p2`]), local nodes v0, v1, v2, mid(0,1), mid(1,2), mid(2,0);
+//! Straight P2 triangles ([`crate::fem::p2tri::P2Triangle`]), local nodes v0, v1, v2, mid(0,1), mid(1,2), mid(2,0);
 //! P and H are both P2 fields given by nodal values (H = H0 + (X^2+Z^2)/2 - U_y is exactly
 //! P2 when U_y is; the caller computes the nodal H).
 //!
@@ -27,8 +27,9 @@
 //! (f = 0 for the physical problem; [`reynolds_element_with_source`] takes an f(X, Z) for
 //! manufactured solutions.)
 //!
-//! Quadrature: Dunavant's 12-point degree-6 rule ([`quadrature::DUNAVANT6`]), all weights
-//! positive, points interior.
+//! Element and quadrature from [`crate::fem`]: the straight P2 triangle
+//! ([`crate::fem::p2tri::P2Triangle`]) and Dunavant's 12-point degree-6 rule
+//! ([`crate::fem::quadrature::DUNAVANT6`]), all weights positive, points interior.
 //!
 //! # SUPG stabilisation (consistent, residual based)
 //! When [`Stabilisation::supg`] is set, each element adds
@@ -81,7 +82,7 @@
 //! evaluated when SUPG is on). Verified against central finite differences in the tests.
 //!
 //! Not included here (the caller's business): the cavitation penalty, the load balance
-//! (use [`p2::P2Triangle::load_weights`] for int P), the elastic coupling H(U_y).
+//! (use [`crate::fem::p2tri::P2Triangle::load_weights`] for int P), the elastic coupling H(U_y).
 
 // Index loops mirror the formulas (N_i, dR_i/dP_j) in this numeric code.
 #![allow(clippy::needless_range_loop)]
@@ -90,9 +91,6 @@ pub mod cavitation;
 pub mod dual;
 pub mod element;
 pub mod estimate;
-pub mod p1;
-pub mod p2;
-pub mod quadrature;
 
 #[cfg(test)]
 mod tests;
@@ -102,33 +100,7 @@ pub use element::{
     reynolds_element, reynolds_element_with_source, streamline_length, xi, ElementOut, Fluid,
     Stabilisation,
 };
-pub use p2::P2Triangle;
 
 /// The 4 sub-triangles of a P2 triangle (local nodes v0, v1, v2, m01, m12, m20), same
 /// orientation as the parent.
 pub const P2_SUB_TRIANGLES: [[usize; 3]; 4] = [[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]];
-
-/// A P1 pressure (linear on each P2 face triangle, unknowns at its 3 vertices) as a P2
-/// field: local node k of the P2 triangle takes `sum w P(v)` over its entries `(v, w)` here
-/// (a vertex its own value, a mid-side node the mean of its edge's two vertices; weight 0
-/// pads the vertices' second entry). This is the prolongation T with P2 = T P1.
-pub const P1_IN_P2: [[(usize, f64); 2]; 6] = [
-    [(0, 1.0), (0, 0.0)],
-    [(1, 1.0), (1, 0.0)],
-    [(2, 1.0), (2, 0.0)],
-    [(0, 0.5), (1, 0.5)],
-    [(1, 0.5), (2, 0.5)],
-    [(2, 0.5), (0, 0.5)],
-];
-
-/// Developer switch (experimental, condensed path only): P1 pressure on the vertices of the
-/// P2 face triangles with the P2 film (`EHL_P1P=1`; see [`P1_IN_P2`]).
-pub fn p1_pressure() -> bool {
-    std::env::var_os("EHL_P1P").is_some()
-}
-
-/// Developer switch (experimental, condensed path only): pressure linear on the 4
-/// sub-triangles of every P2 face triangle (`EHL_P1ISO=1`).
-pub fn p1iso_pressure() -> bool {
-    std::env::var_os("EHL_P1ISO").is_some()
-}

@@ -2,8 +2,8 @@
 //! convergence, and what SUPG does on an advection-dominated problem.
 
 use super::element::*;
-use super::p2::P2Triangle;
-use super::quadrature::DUNAVANT6;
+use crate::fem::p2tri::P2Triangle;
+use crate::fem::quadrature::DUNAVANT6;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 

@@ -78,9 +78,8 @@ impl Drop for OwnedIs {
 }
 
 /// The P2 face mass matrix B[i][j] = integral over the face of N_i N_j for face rows
-/// `rows` and pressure columns `cols` (dense, row-major); with a P1 pressure (columns at the
-/// triangles' vertices) the integral of N_i times the vertex's P1 hat function, M T.
-fn face_mass(mesh: &Mesh, rows: &[u32], cols: &[u32], p1: bool) -> Vec<f64> {
+/// `rows` and pressure columns `cols` (dense, row-major).
+fn face_mass(mesh: &Mesh, rows: &[u32], cols: &[u32]) -> Vec<f64> {
     let mut row_of = vec![-1i64; mesh.nodes.len()];
     for (i, &n) in rows.iter().enumerate() {
         row_of[n as usize] = i as i64;
@@ -91,70 +90,26 @@ fn face_mass(mesh: &Mesh, rows: &[u32], cols: &[u32], p1: bool) -> Vec<f64> {
     }
     let nc = cols.len();
     let mut b = vec![0.0; rows.len() * nc];
-    if crate::reynolds::p1iso_pressure() {
-        // Pressure linear on the 4 sub-triangles (P1-iso-P2), displacement test functions P2:
-        // B[i][j] = int N_i^{P2} phi_j, by a degree-6 rule on each sub-triangle.
-        use crate::fem::p2tri::{tri_bary, P2_TRI_REF_NODES};
-        let bary = P2_TRI_REF_NODES.map(tri_bary);
-        for tri in &mesh.contact_tris {
-            let xz = |n: u32| {
-                let c = mesh.nodes[n as usize];
-                [c[0], c[2]]
-            };
-            let area = crate::ehl::system::tri_area(&[xz(tri[0]), xz(tri[1]), xz(tri[2])]) / 4.0;
-            for sub in crate::reynolds::P2_SUB_TRIANGLES {
-                for q in crate::reynolds::quadrature::DUNAVANT6.iter() {
-                    let lp: [f64; 3] = std::array::from_fn(|c| (0..3).map(|k| q.l[k] * bary[sub[k]][c]).sum());
-                    let n2 = crate::fem::p2tri::p2_tri_basis_bary(lp);
-                    for a in 0..6 {
-                        let i = row_of[tri[a] as usize];
-                        if i < 0 {
-                            continue;
-                        }
-                        for k in 0..3 {
-                            let j = col_of[tri[sub[k]] as usize];
-                            if j >= 0 {
-                                b[i as usize * nc + j as usize] += q.w * area * n2[a] * q.l[k];
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        return b;
-    }
     for tri in &mesh.contact_tris {
         let xz = |n: u32| {
             let c = mesh.nodes[n as usize];
             [c[0], c[2]]
         };
-        let m = crate::ehl::system::p2_tri_mass(crate::ehl::system::tri_area(&[xz(tri[0]), xz(tri[1]), xz(tri[2])]));
+        let m = crate::fem::p2tri::p2_tri_mass(crate::fem::p2tri::tri_area(&[xz(tri[0]), xz(tri[1]), xz(tri[2])]));
         for a in 0..6 {
             let i = row_of[tri[a] as usize];
             if i < 0 {
                 continue;
             }
             for (bb, &mab) in m[a].iter().enumerate() {
-                // The pressure columns of local node bb: itself, or with a P1 pressure the
-                // vertices it interpolates (M T).
-                for (v, w) in pressure_of_node(bb, p1) {
-                    let j = col_of[tri[v] as usize];
-                    if j >= 0 {
-                        b[i as usize * nc + j as usize] += w * mab;
-                    }
+                let j = col_of[tri[bb] as usize];
+                if j >= 0 {
+                    b[i as usize * nc + j as usize] += mab;
                 }
             }
         }
     }
     b
-}
-
-/// The pressure unknowns (local vertex or node, weight) that local node `k` of a P2 face
-/// triangle takes its pressure from: itself (P2 pressure) or the vertices of
-/// [`crate::reynolds::P1_IN_P2`] (P1 pressure).
-pub fn pressure_of_node(k: usize, p1: bool) -> impl Iterator<Item = (usize, f64)> {
-    let entries = if p1 { crate::reynolds::P1_IN_P2[k] } else { [(k, 1.0), (k, 0.0)] };
-    entries.into_iter().filter(|&(_, w)| w != 0.0)
 }
 
 /// Computes the face compliance of the equivalent solid (Poisson ratio `nu`, traction
@@ -186,7 +141,7 @@ pub fn face_compliance(world: &SimpleCommunicator, mesh: &Mesh, nu: f64, tractio
         return Err(rust_error("static condensation of the elastic block failed on rank 0 (see its message)"));
     }
     world.process_at_rank(0).broadcast_into(&mut s[..]);
-    let dbg = std::env::var_os("EHL_DEBUG").is_some();
+    let dbg = crate::ehl_options::get().monitor;
     if dbg && world.rank() == 0 {
         eprintln!("condense: S on every rank {:.2} s", t0.elapsed().as_secs_f64());
     }
@@ -195,7 +150,7 @@ pub fn face_compliance(world: &SimpleCommunicator, mesh: &Mesh, nu: f64, tractio
     let blocks = crate::mesh::equal_blocks(nc, size);
     let span = |r: usize| (blocks[r], blocks[r + 1]);
     let (c0, c1) = span(world.rank() as usize);
-    let mine = solve_columns(&mut s, nr, &face_mass(mesh, &rows, &cols[c0..c1], crate::reynolds::p1_pressure()), traction)?;
+    let mine = solve_columns(&mut s, nr, &face_mass(mesh, &rows, &cols[c0..c1]), traction)?;
     drop(s);
     // Gather the column blocks (column-major, nr x block) and store C row-major.
     let counts: Vec<i32> = (0..size).map(|r| ((span(r).1 - span(r).0) * nr) as i32).collect();
@@ -260,7 +215,7 @@ fn schur_complement(mesh: &Mesh, part: &crate::mesh::Partition, dofs: &DofMap, n
     let selfc = unsafe { ffi::RSMPI_COMM_SELF };
     let t = std::time::Instant::now();
     let k = assemble_stiffness(selfc, mesh, part, dofs, 0, nu)?;
-    let dbg = std::env::var_os("EHL_DEBUG").is_some();
+    let dbg = crate::ehl_options::get().monitor;
     if dbg { eprintln!("condense: K assembled {:.2} s", t.elapsed().as_secs_f64()); }
     // K is symmetric positive definite (clamped base): MUMPS LDL^T without pivoting.
     pcall!(ffi::MatSetOption(k.raw(), ffi::MatOption_MAT_SPD, ffi::PetscBool_PETSC_TRUE))?;
@@ -298,51 +253,4 @@ fn schur_complement(mesh: &Mesh, part: &crate::mesh::Partition, dofs: &DofMap, n
     let out = (0..nr).flat_map(|j| a[j * lda..j * lda + nr].iter().copied()).collect();
     pcall!(ffi::MatDenseRestoreArrayRead(s.0, &mut ptr))?;
     Ok(out)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::face_mass;
-    use crate::mesh::{generate, MeshSpec};
-
-    /// M T (P1 pressure columns) against integrals known in closed form: each column is the
-    /// integral of N_i times a vertex's P1 hat, so a column sums (over i, where the N_i sum
-    /// to 1) to a third of the area of the triangles at that vertex; and T interpolates a
-    /// linear pressure exactly, so M T applied to a linear function's vertex values equals
-    /// the P2 mass M applied to its values at all 6 nodes.
-    #[test]
-    fn p1_face_mass_is_the_p2_mass_times_the_interpolation() {
-        let mut spec = MeshSpec::paper_default();
-        spec.contact_size = 1.0;
-        let mesh = generate(&spec).unwrap();
-        let rows = mesh.contact_nodes.clone();
-        let mut is_vertex = vec![false; mesh.nodes.len()];
-        let mut hat = vec![0.0; mesh.nodes.len()];
-        for tri in &mesh.contact_tris {
-            let xz = |n: u32| [mesh.nodes[n as usize][0], mesh.nodes[n as usize][2]];
-            let area = crate::ehl::system::tri_area(&[xz(tri[0]), xz(tri[1]), xz(tri[2])]);
-            for &v in &tri[..3] {
-                is_vertex[v as usize] = true;
-                hat[v as usize] += area / 3.0;
-            }
-        }
-        let verts: Vec<u32> = rows.iter().copied().filter(|&n| is_vertex[n as usize]).collect();
-        assert!(verts.len() * 3 < rows.len(), "a P2 face has about 4 nodes per vertex");
-        let b1 = face_mass(&mesh, &rows, &verts, true);
-        let b2 = face_mass(&mesh, &rows, &rows, false);
-        let (n1, n2) = (verts.len(), rows.len());
-        for (j, &v) in verts.iter().enumerate() {
-            let sum: f64 = (0..n2).map(|i| b1[i * n1 + j]).sum();
-            assert!((sum - hat[v as usize]).abs() < 1e-12 * hat[v as usize].max(1.0), "column {j}: {sum} vs {}", hat[v as usize]);
-        }
-        let f = |n: u32| {
-            let c = mesh.nodes[n as usize];
-            0.7 + 0.3 * c[0] - 1.1 * c[2]
-        };
-        for i in 0..n2 {
-            let a: f64 = verts.iter().enumerate().map(|(j, &v)| b1[i * n1 + j] * f(v)).sum();
-            let b: f64 = rows.iter().enumerate().map(|(j, &n)| b2[i * n2 + j] * f(n)).sum();
-            assert!((a - b).abs() < 1e-12, "row {i}: M T f = {a}, M f = {b}");
-        }
-    }
 }

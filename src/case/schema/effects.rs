@@ -1,0 +1,174 @@
+//! `[effects]`: which physical effects are on, as choice enums.
+use super::*;
+
+// ---------------------------------------------------------------------------------------
+// [effects]
+
+choice_enum! {
+    /// `effects.lubrication`: is there a lubricant film?
+    pub enum LubricationModel {
+        /// Full-system EHL: Reynolds equation coupled with elasticity.
+        Reynolds = "reynolds",
+        /// Dry Hertz contact: the Hertz pressure is applied as traction; the lubricant is
+        /// ignored (and may be absent).
+        Dry = "none",
+    } default = Reynolds
+}
+
+choice_enum! {
+    /// `effects.elasticity`: deformable or rigid solids.
+    pub enum ElasticityModel {
+        /// Linear elastic equivalent solid (paper Eq. 8).
+        Elastic = "elastic",
+        /// Rigid solids: u2 = 0 in the film (hydrodynamic lubrication).
+        Rigid = "rigid",
+    } default = Elastic
+}
+
+choice_enum! {
+    /// `effects.viscosity`: pressure-viscosity law.
+    pub enum ViscosityModel {
+        /// Roelands (paper Eq. 6).
+        Roelands = "roelands",
+        /// Barus eta_R exp(alpha p).
+        Barus = "barus",
+        /// eta = eta_R.
+        Constant = "constant",
+    } default = Roelands
+}
+
+choice_enum! {
+    /// `effects.density`: pressure-density law.
+    pub enum DensityModel {
+        /// Dowson-Higginson.
+        DowsonHigginson = "dowson-higginson",
+        /// rho = rho_R.
+        Incompressible = "incompressible",
+    } default = DowsonHigginson
+}
+
+choice_enum! {
+    /// `effects.kinematics`: surface velocities.
+    pub enum KinematicsModel {
+        /// Rolling, sliding and spinning (physics.md section 3).
+        Spin = "spin",
+        /// Uniform surface velocities U_BO, U_DO, no spin.
+        Uniform = "uniform",
+    } default = Spin
+}
+
+choice_enum! {
+    /// `effects.friction`: the shear-stress post-processing pass.
+    pub enum FrictionModel {
+        /// Ree-Eyring (paper Section 3).
+        ReeEyring = "ree-eyring",
+        /// Newtonian shear.
+        Newtonian = "newtonian",
+        /// No friction computation.
+        Off = "none",
+    } default = ReeEyring
+}
+
+choice_enum! {
+    /// `effects.cavitation`: how p >= 0 is enforced.
+    pub enum CavitationModel {
+        /// Penalty term -xi min(p, 0) (xi = `reynolds.penalty`).
+        Penalty = "penalty",
+        /// None: negative pressures are kept.
+        Off = "none",
+    } default = Penalty
+}
+
+choice_enum! {
+    /// `effects.symmetry`: may the solver use a symmetry plane?
+    pub enum SymmetryMode {
+        /// Use the plane z = 0 when the case is symmetric (no spin, see the solver).
+        Auto = "auto",
+        /// Always solve the full domain.
+        Off = "off",
+    } default = Auto
+}
+
+/// `[effects]`: which physics is simulated. Every key is optional; the defaults are the
+/// paper's model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Effects {
+    /// "reynolds" | "none" (dry Hertz); default "reynolds".
+    pub lubrication: LubricationModel,
+    /// "elastic" | "rigid"; default "elastic".
+    pub elasticity: ElasticityModel,
+    /// "roelands" | "barus" | "constant"; default "roelands".
+    pub viscosity: ViscosityModel,
+    /// "dowson-higginson" | "incompressible"; default "dowson-higginson".
+    pub density: DensityModel,
+    /// "spin" | "uniform"; default "spin".
+    pub kinematics: KinematicsModel,
+    /// "ree-eyring" | "newtonian" | "none"; default "ree-eyring".
+    pub friction: FrictionModel,
+    /// "penalty" | "none"; default "penalty".
+    pub cavitation: CavitationModel,
+    /// "auto" | "off"; default "auto".
+    pub symmetry: SymmetryMode,
+}
+
+/// Keys of `[effects]`.
+pub const EFFECTS_FIELDS: &[Field] = &[
+    f!(
+        "lubrication",
+        "lubricant film (\"none\" = dry Hertz traction)",
+        "",
+        Kind::Choice(LubricationModel::NAMES),
+        Presence::Default("\"reynolds\"")
+    ),
+    f!(
+        "elasticity",
+        "deformation of the solids",
+        "",
+        Kind::Choice(ElasticityModel::NAMES),
+        Presence::Default("\"elastic\"")
+    ),
+    f!(
+        "viscosity",
+        "pressure-viscosity law",
+        "",
+        Kind::Choice(ViscosityModel::NAMES),
+        Presence::Default("\"roelands\"")
+    ),
+    f!(
+        "density",
+        "pressure-density law",
+        "",
+        Kind::Choice(DensityModel::NAMES),
+        Presence::Default("\"dowson-higginson\"")
+    ),
+    f!(
+        "kinematics",
+        "surface velocities (spin or uniform)",
+        "",
+        Kind::Choice(KinematicsModel::NAMES),
+        Presence::Default("\"spin\"")
+    ),
+    f!(
+        "friction",
+        "shear-stress model of the friction pass",
+        "",
+        Kind::Choice(FrictionModel::NAMES),
+        Presence::Default("\"ree-eyring\"")
+    ),
+    f!(
+        "cavitation",
+        "cavitation model",
+        "",
+        Kind::Choice(CavitationModel::NAMES),
+        Presence::Default("\"penalty\"")
+    ),
+    f!(
+        "symmetry",
+        "use of a symmetry plane",
+        "",
+        Kind::Choice(SymmetryMode::NAMES),
+        Presence::Default("\"auto\"")
+    ),
+];
+

@@ -1,0 +1,387 @@
+//! Newton with continuation. Plain Newton runs first at the base problem (the scene, with
+//! a stiff cavitation penalty lowered to [`PENALTY_START`]); if it fails from the Hertz
+//! start, the homotopies of [`homotopies`] are tried in order, each a scene parameter and
+//! a ramp: find a milder problem Newton solves from the start, then ramp the parameter back
+//! to the scene's value, each converged state starting the next solve. Last, a staged
+//! penalty is ramped from [`PENALTY_START`] to the scene's. Every Newton solve is logged and
+//! kept in the path.
+use super::diagnostics::Collapse;
+use super::policy::{set_newton_linear_solver, Policy};
+use super::problem::{lambda_bar, lubricant, penalty, velocity_field};
+use crate::case::Scene;
+use crate::context::Context;
+use crate::ehl::system::EhlProblem;
+use crate::petsc::snes::{Snes, SolveReport};
+use crate::petsc::{self, Matrix, Vector};
+
+/// The cavitation penalty the penalty continuation starts from (Newton converges from the
+/// Hertz start with it on every mesh measured; README "The cavitation penalty and the finer
+/// ring").
+const PENALTY_START: f64 = 1e3;
+
+/// Outcome of [`newton_with_continuation`].
+pub(super) struct NewtonOutcome {
+    pub(super) x: Vec<f64>,
+    pub(super) report: SolveReport,
+    pub(super) newton_total: usize,
+    pub(super) steps: Vec<String>,
+}
+
+/// A scene parameter a continuation varies, with the scene's value: at t = 1 the scene
+/// itself, at smaller t a milder problem.
+#[derive(Clone, Copy, Debug)]
+enum Parameter {
+    /// The tilt angle lambda (deg) becomes min(lambda / t, 90): weaker spin.
+    Tilt(f64),
+    /// The pressure-viscosity coefficient alpha (1/Pa) and the Roelands exponent z are
+    /// scaled by t: a less steep viscosity at the same Hertz geometry.
+    PressureViscosity { alpha: f64, z: Option<f64> },
+    /// The load (N) is scaled by t: smaller M and alpha p_H.
+    Load(f64),
+    /// The entrainment speed (m/s) becomes Ue / t: a thicker film.
+    Speed(f64),
+    /// The cavitation penalty xi is scaled by t.
+    Penalty(f64),
+}
+
+impl Parameter {
+    fn name(self) -> &'static str {
+        match self {
+            Parameter::Tilt(_) => "tilt",
+            Parameter::PressureViscosity { .. } => "pressure-viscosity",
+            Parameter::Load(_) => "load",
+            Parameter::Speed(_) => "speed",
+            Parameter::Penalty(_) => "penalty",
+        }
+    }
+
+    /// Sets the parameter of `sc` at t.
+    fn apply(self, sc: &mut Scene, t: f64) {
+        match self {
+            Parameter::Tilt(tilt) => sc.operating.tilt_angle = (tilt / t).min(90.0),
+            Parameter::PressureViscosity { alpha, z } => {
+                if let Some(l) = sc.lubricant.as_mut() {
+                    l.pressure_viscosity = l.pressure_viscosity.map(|_| alpha * t);
+                    l.roelands_exponent = z.map(|z| z * t);
+                }
+            }
+            Parameter::Load(load) => sc.operating.load = load * t,
+            Parameter::Speed(ue) => sc.operating.entrainment_speed = Some(ue / t),
+            Parameter::Penalty(xi) => sc.reynolds.penalty = xi * t,
+        }
+    }
+
+    /// The parameter's value at t, for the log.
+    fn show(self, t: f64) -> String {
+        match self {
+            Parameter::Tilt(tilt) => format!("lambda = {:.4} deg", (tilt / t).min(90.0)),
+            Parameter::PressureViscosity { alpha, .. } => format!("alpha = {:.4} GPa^-1", alpha * t * 1e9),
+            Parameter::Load(load) => format!("L = {:.4} N", load * t),
+            Parameter::Speed(ue) => format!("Ue = {:.4} m/s", ue / t),
+            Parameter::Penalty(xi) => format!("xi = {:.4e}", xi * t),
+        }
+    }
+
+    /// The parameter changes the entrainment velocity field.
+    fn kinematic(self) -> bool {
+        matches!(self, Parameter::Tilt(_))
+    }
+
+    /// A smaller t gives a thinner film (pressure-viscosity: hc grows about as alpha^0.5),
+    /// so once a try ends with the film closed, the smaller t that follow would close it too.
+    fn thins_film(self) -> bool {
+        matches!(self, Parameter::PressureViscosity { .. })
+    }
+}
+
+/// How t moves: the search for a milder problem tries `first`, halving down to `lowest`;
+/// the ramp back to t = 1 multiplies t by `ratio` (by its square root after a failure).
+#[derive(Clone, Copy, Debug)]
+struct Ramp {
+    first: f64,
+    lowest: f64,
+    ratio: f64,
+}
+
+/// One continuation: a parameter and its ramp.
+#[derive(Clone, Copy, Debug)]
+struct Homotopy {
+    parameter: Parameter,
+    ramp: Ramp,
+}
+
+/// The continuations tried, in order, when Newton fails from the Hertz start: first (spin
+/// kinematics, lambda < 90 deg) the tilt angle, then pressure-viscosity (alpha > 0), then
+/// load, then speed. Pressure-viscosity goes before load: on the hard suite it is the one
+/// that converges (alpha30 on the paper mesh: load continuation fails from every Hertz
+/// start down to L/64, alpha/2 -> alpha converges in 23 + 8 iterations).
+fn homotopies(scene: &Scene) -> Vec<Homotopy> {
+    let alpha = scene.lubricant.as_ref().and_then(|l| l.pressure_viscosity).unwrap_or(0.0);
+    let z = scene.lubricant.as_ref().and_then(|l| l.roelands_exponent);
+    let ue = scene.operating.entrainment_speed.unwrap_or(0.0);
+    let tilt = scene.operating.tilt_angle;
+    // A small tilt angle (strong spin) is milder at a larger one; only with spin kinematics.
+    let spin = scene.effects.kinematics == crate::case::KinematicsModel::Spin && tilt < 90.0;
+    let halving = |first: f64, lowest: f64| Ramp { first, lowest, ratio: 2.0 };
+    let mut list = Vec::new();
+    if spin {
+        list.push(Homotopy { parameter: Parameter::Tilt(tilt), ramp: halving(0.5, 1.0 / 64.0) });
+    }
+    if alpha > 0.0 {
+        list.push(Homotopy { parameter: Parameter::PressureViscosity { alpha, z }, ramp: halving(0.5, 0.125) });
+    }
+    list.push(Homotopy { parameter: Parameter::Load(scene.operating.load), ramp: halving(1.0 / 8.0, 1.0 / 64.0) });
+    list.push(Homotopy { parameter: Parameter::Speed(ue), ramp: halving(0.25, 1.0 / 64.0) });
+    list
+}
+
+/// The Newton solver shared by every solve of the path, and the path so far.
+struct Newton<'a> {
+    ctx: &'a Context,
+    snes: Snes,
+    /// The iterate (distributed).
+    x: Vector,
+    j: &'a Matrix,
+    /// This rank's rows.
+    owned: (usize, usize),
+    row_scaling: bool,
+    /// Where the film closed, if the last solve stopped for that.
+    collapse: Option<Collapse>,
+    /// Every Newton solve, logged as it ends.
+    steps: Vec<String>,
+    /// Newton iterations over the path.
+    iterations: usize,
+}
+
+impl Newton<'_> {
+    fn note(&mut self, s: String) {
+        self.ctx.log(&s);
+        self.steps.push(s);
+    }
+
+    /// One Newton solve of the scene `sc` from `start`.
+    fn solve(&mut self, sc: &Scene, system: &mut dyn EhlProblem, start: &[f64]) -> Result<SolveReport, String> {
+        let pe = |e: petsc::PetscError| e.to_string();
+        let (lo, hi) = self.owned;
+        system.set_operating(lambda_bar(sc), lubricant(sc), penalty(sc));
+        self.x.set_local_values(&start[lo..hi]).map_err(pe)?;
+        if self.row_scaling {
+            system.scale_rows(start).map_err(pe)?;
+        }
+        system.take_collapse();
+        self.collapse = None;
+        let mut r = self.snes.solve(system, &self.x, self.j).map_err(pe)?;
+        if let (false, Some(c)) = (r.converged, system.take_collapse()) {
+            r.reason = format!("{}: film closed at ({:.3}, {:.3})a", r.reason, c[0], c[1]);
+            self.collapse = Some(Collapse { at: c, pole: sc.spin_pole_over_a() });
+        }
+        Ok(r)
+    }
+
+    /// The converged iterate of the last solve, gathered.
+    fn solution(&self) -> Result<Vec<f64>, String> {
+        self.x.gather_all().map_err(|e| e.to_string())
+    }
+
+    /// One Newton solve of `from` with `p` at t, from `start`; the step is logged (`what`
+    /// before the parameter's value) and kept in the path. Returns the report and, if
+    /// converged, the state.
+    fn solve_at(&mut self, from: &Scene, p: Parameter, t: f64, system: &mut dyn EhlProblem, start: &[f64], what: &str) -> Result<(SolveReport, Option<Vec<f64>>), String> {
+        crate::interrupt::check("the continuation")?;
+        let mut sc = from.clone();
+        p.apply(&mut sc, t);
+        if p.kinematic() {
+            system.set_velocity(velocity_field(&sc));
+        }
+        let r = self.solve(&sc, system, start)?;
+        self.iterations += r.iterations;
+        self.note(format!("{} continuation: {what}{}: {} ({} iterations)", p.name(), p.show(t), r.reason, r.iterations));
+        let xs = if r.converged { Some(self.solution()?) } else { None };
+        Ok((r, xs))
+    }
+
+    /// Searches a milder problem Newton solves from `x0` (described by `label`): t from
+    /// the ramp's first value, halved down to its lowest. Returns t and the converged state,
+    /// or None (logged) if none converged.
+    fn search(&mut self, from: &Scene, h: &Homotopy, system: &mut dyn EhlProblem, x0: &[f64], label: &str) -> Result<Option<(f64, Vec<f64>)>, String> {
+        let (p, lowest) = (h.parameter, h.ramp.lowest);
+        let mut t = h.ramp.first;
+        while t >= lowest {
+            if let (_, Some(xs)) = self.solve_at(from, p, t, system, x0, &format!("{label} at "))? {
+                return Ok(Some((t, xs)));
+            }
+            // heavy-3gpa: the film closed at alpha/2, alpha/4 and alpha/8 alike (4 min of
+            // the 10 on its patch mesh); no try after a closed film has converged.
+            if p.thins_film() && self.collapse.is_some() {
+                break;
+            }
+            t /= 2.0;
+        }
+        if t >= lowest {
+            self.note(format!("{} continuation: the film closed at {}; a smaller value gives a thinner film, so the search stops", p.name(), p.show(t)));
+        } else {
+            self.note(format!("{} continuation: no milder problem converged down to {}", p.name(), p.show(lowest)));
+        }
+        Ok(None)
+    }
+
+    /// Ramps `h` from t (where `state` is converged) to the scene's problem at t = 1,
+    /// multiplying t by the ramp's ratio, by its square root after each failure, and giving
+    /// up below a ratio of 1.05. Returns whether t = 1 converged, the last report and the
+    /// last converged state.
+    fn ramp(&mut self, from: &Scene, h: &Homotopy, mut t: f64, mut state: Vec<f64>, system: &mut dyn EhlProblem) -> Result<(bool, Option<SolveReport>, Vec<f64>), String> {
+        let mut ratio = h.ramp.ratio;
+        let mut last = None;
+        while t < 1.0 {
+            // Within round-off of the end is the end (heavy-3gpa's load ramp by factors of
+            // 2^(1/4) ended at t = 1 - 1e-16, then solved t = 1 again in 0 iterations).
+            let next = if t * ratio > 1.0 - 1e-9 { 1.0 } else { t * ratio };
+            let (r, xs) = self.solve_at(from, h.parameter, next, system, &state, "")?;
+            match xs {
+                Some(xs) => {
+                    state = xs;
+                    t = next;
+                }
+                None => {
+                    ratio = ratio.sqrt();
+                    if ratio < 1.05 {
+                        return Ok((false, Some(r), state));
+                    }
+                }
+            }
+            last = Some(r);
+        }
+        Ok((true, last, state))
+    }
+}
+
+/// Newton from `x0` (described by `label`) at the scene's operating point, as the policy
+/// says: with `stages_penalty`, a stiff cavitation penalty (xi > 1e3) is solved at xi = 1e3
+/// first; with `continues`, if that fails, the [`homotopies`] from a milder problem to the
+/// scene's (at xi = 1e3); last the penalty from 1e3 to the scene's xi. Returns the
+/// converged iterate (gathered) or an error naming the path taken.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], label: &str, policy: Policy, j: &Matrix, owned: (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
+    let pe = |e: petsc::PetscError| e.to_string();
+    petsc::options::set_ours("-snes_linesearch_type", policy.line_search).map_err(pe)?;
+    set_newton_linear_solver(policy.reuses_lu).map_err(pe)?;
+    let comm = petsc::comm_world();
+    let opts = crate::ehl_options::get();
+    let mut nw = Newton {
+        ctx,
+        snes: Snes::new(comm, "").map_err(pe)?,
+        x: Vector::new(comm, local).map_err(pe)?,
+        j,
+        owned,
+        row_scaling: opts.row_scaling,
+        collapse: None,
+        steps: Vec::new(),
+        iterations: 0,
+    };
+    // The problem solved first. A stiff cavitation penalty (xi > 1e3) is reached last, from
+    // the solution at xi = 1e3: on fine rings Newton crawls at xi = 1e4 from the Hertz start
+    // (each step flips nodes across the penalty's kink; 30 iterations wasted on table2-ue2
+    // with the ring halved), while from the xi = 1e3 solution the cavitated set is already
+    // right. Every other continuation runs at xi = 1e3 too, where Newton converges from the
+    // Hertz start on every mesh measured (README "The cavitation penalty and the finer ring").
+    // A pressure from another mesh is staged the same way, a previous state of the same mesh
+    // (a sweep) goes straight to the scene's xi ([`Policy::stages_penalty`]).
+    let target = scene.operating.load;
+    let xi = penalty(scene);
+    let staged = policy.stages_penalty && xi > PENALTY_START;
+    let mut base = scene.clone();
+    if staged {
+        base.reynolds.penalty = PENALTY_START;
+    }
+    // 1. Plain Newton from the start at the base problem.
+    let report = if opts.skip_plain {
+        SolveReport { converged: false, reason: "SKIPPED".into(), reason_code: 0, iterations: 0, linear_iterations: 0, residual_norm: f64::NAN, domain_error: None }
+    } else {
+        nw.solve(&base, system, x0)?
+    };
+    let at_xi = if staged { format!(", xi = {PENALTY_START:e}") } else { String::new() };
+    nw.note(format!("Newton from {label} at L = {target} N{at_xi}: {} ({} iterations)", report.reason, report.iterations));
+    nw.iterations = report.iterations;
+    let mut last = report;
+    // The converged state of the base problem.
+    let mut state: Option<Vec<f64>> = if last.converged { Some(nw.solution()?) } else { None };
+    // 2. If it failed: the continuations, each from a milder problem back to the base one.
+    if state.is_none() && policy.continues {
+        for h in homotopies(scene) {
+            // A kinematic parameter also needs a problem whose velocity field can change.
+            if h.parameter.kinematic() && !system.set_velocity(velocity_field(scene)) {
+                continue;
+            }
+            let Some((t, from)) = nw.search(&base, &h, system, x0, label)? else { continue };
+            let (done, r, xs) = nw.ramp(&base, &h, t, from, system)?;
+            if let Some(r) = r {
+                last = r;
+            }
+            if done {
+                state = Some(xs);
+                break;
+            }
+            if h.parameter.kinematic() {
+                // Back to the scene's own velocity field for what follows.
+                system.set_velocity(velocity_field(scene));
+                // The film closed at the spin pole on the way to the scene's tilt: every
+                // other continuation ends at the same problem, with the pole at the same place.
+                if let Some(why) = nw.collapse.and_then(|c| c.at_pole()) {
+                    nw.note(format!("{}: {why}; the other continuations end at the same tilt, so they are not tried", h.parameter.name()));
+                    break;
+                }
+            }
+        }
+    }
+    // 3. The stiff penalty: from the base solution, xi goes to the scene's in one step (its
+    //    square root, and so on, on failure). table2-ue2 with the ring halved, xi = 1e4: 11
+    //    iterations at 1e3, then 7 to 1e4 (135 s); by factors of sqrt(10): 6 + 5 (162 s);
+    //    plain Newton at 1e4 from the Hertz start: DIVERGED_MAX_IT after 30.
+    if let Some(from) = state.take_if(|_| staged) {
+        let first = PENALTY_START / xi;
+        let h = Homotopy { parameter: Parameter::Penalty(xi), ramp: Ramp { first, lowest: first, ratio: xi / PENALTY_START } };
+        let (done, r, xs) = nw.ramp(scene, &h, first, from, system)?;
+        if let Some(r) = r {
+            last = r;
+        }
+        state = if done { Some(xs) } else { None };
+    }
+    let Some(xs) = state else {
+        return Err(format!(
+            "Newton did not converge: {} after {} iterations (residual norm {:.3e}){}{}; path: {}",
+            last.reason,
+            last.iterations,
+            last.residual_norm,
+            last.domain_error.as_ref().map(|d| format!("; last domain error: {d}")).unwrap_or_default(),
+            nw.collapse.and_then(|c| c.at_pole()).map(|w| format!("; {w}")).unwrap_or_default(),
+            nw.steps.join("; ")
+        ));
+    };
+    Ok(NewtonOutcome { x: xs, report: last, newton_total: nw.iterations, steps: nw.steps })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{homotopies, Parameter};
+
+    #[test]
+    fn the_homotopies_reach_the_scene_at_t_equal_1_and_are_milder_below() {
+        let scene = crate::case::parse_scene(include_str!("../../../cases/paper/table2-ue2.toml"), "table2-ue2").unwrap();
+        let list = homotopies(&scene);
+        let names: Vec<&str> = list.iter().map(|h| h.parameter.name()).collect();
+        // Table 2 has alpha > 0 and rolls without spin: no tilt continuation.
+        assert_eq!(names, ["pressure-viscosity", "load", "speed"]);
+        for h in &list {
+            let mut sc = scene.clone();
+            h.parameter.apply(&mut sc, 1.0);
+            assert_eq!(sc.operating, scene.operating, "{}", h.parameter.name());
+            assert_eq!(sc.lubricant, scene.lubricant, "{}", h.parameter.name());
+        }
+        // At t = 1/2: half the load, twice the speed (a thicker film), half of alpha.
+        let mut sc = scene.clone();
+        Parameter::Load(scene.operating.load).apply(&mut sc, 0.5);
+        Parameter::Speed(scene.operating.entrainment_speed.unwrap()).apply(&mut sc, 0.5);
+        assert_eq!(sc.operating.load, 0.5 * scene.operating.load);
+        assert_eq!(sc.operating.entrainment_speed, Some(2.0 * scene.operating.entrainment_speed.unwrap()));
+    }
+}

@@ -1,0 +1,288 @@
+//! The lubricated solve: builds the coupled system, starts Newton (PETSc SNES) from the dry
+//! Hertz state or a given start, and falls back to an automatic continuation when Newton
+//! fails from the Hertz start. The parts, each in its own file:
+//! - `problem`: the scene as a dimensionless problem (lambda_bar, lubricant laws,
+//!   velocity field, penalty, stabilisation);
+//! - `start`: where Newton starts;
+//! - `continuation`: Newton with the continuation, a list of homotopies (parameter, ramp);
+//! - `policy`: the coupling ([`Coupling`]) and the PETSc options each solve sets;
+//! - `diagnostics`: why the film closed, the finite-difference Jacobian check.
+//!
+//! Developer options (`-ehl_...`, listed by `-help`) are read by [`crate::ehl_options`].
+mod continuation;
+mod diagnostics;
+mod policy;
+mod problem;
+mod start;
+
+pub use diagnostics::check_jacobian;
+pub use policy::{set_newton_defaults, set_newton_linear_solver, Coupling, CONDENSED_PREFIX};
+pub use problem::{lambda_bar, lubricant, velocity_field};
+pub use start::Start;
+
+use continuation::newton_with_continuation;
+use policy::Policy;
+use problem::ehl_params;
+use start::{elastic_start, rigid_start, start_h0};
+use super::condensed::CondensedSystem;
+use super::layout::Layout;
+use super::prealloc::preallocation;
+use super::system::{EhlProblem, EhlSystem};
+use crate::case::Scene;
+use crate::context::Context;
+use crate::mesh::{Mesh, Partition};
+use crate::petsc::snes::SolveReport;
+use crate::petsc::{self, Matrix};
+use crate::solid::{assembly, dofmap::DofMap};
+
+/// Result of a converged lubricated solve (dimensionless state gathered on every rank).
+pub struct EhlSolution {
+    pub x: Vec<f64>,
+    pub report: SolveReport,
+    /// Newton iterations summed over all continuation steps.
+    pub newton_total: usize,
+    /// Continuation steps taken (1 = plain Newton from the Hertz start).
+    pub steps: Vec<String>,
+    pub assembly_s: f64,
+    pub solve_s: f64,
+    /// The coupling solved (see [`EhlSolver::coupling`]).
+    pub coupling: Coupling,
+}
+
+/// The lubricated solver of one mesh: the parts that do not depend on the operating
+/// point (the elastic block condensed onto the contact face) are built once by
+/// [`EhlSolver::new`]; [`EhlSolver::solve`] then solves any operating point of the same
+/// geometry and materials (a sweep), optionally from a previous converged state.
+pub struct EhlSolver<'a> {
+    mesh: &'a Mesh,
+    part: &'a Partition,
+    dofs: &'a DofMap,
+    layout: &'a Layout,
+    half: bool,
+    coupling: Coupling,
+    /// Face compliance (condensed coupling; zero for rigid solids); None on the monolithic
+    /// coupling.
+    comp: Option<crate::solid::condense::Compliance>,
+    /// Seconds spent condensing the elastic block (None: no condensation phase, i.e.
+    /// rigid solids or the monolithic coupling).
+    pub condensation_s: Option<f64>,
+}
+
+impl<'a> EhlSolver<'a> {
+    /// Condenses the elastic block onto the contact face, unless the scene's
+    /// `reynolds.coupling` (see [`Coupling::of_scene`]) asks for the monolithic system.
+    /// Collective.
+    pub fn new(ctx: &Context, scene: &Scene, mesh: &'a Mesh, part: &'a Partition, dofs: &'a DofMap, layout: &'a Layout, half: bool) -> Result<Self, String> {
+        set_newton_defaults().map_err(|e| e.to_string())?;
+        let p_nodes = pressure_nodes(mesh, layout);
+        let coupling = Coupling::of_scene(scene, p_nodes.len());
+        let (rigid, monolithic) = (coupling == Coupling::Rigid, coupling == Coupling::Monolithic);
+        if monolithic {
+            ctx.log(format!("coupling: monolithic (reynolds.coupling = \"{}\", {} pressure unknowns): U, P and H0 in one sparse matrix, a MUMPS LU at every Newton step (every third step, GMRES in between, from a start near the solution)", scene.reynolds.coupling, p_nodes.len()));
+            // The condensed path picks its solver by the Jacobian's type (see `solve_condensed`);
+            // a convergence study may have run it before in this process.
+            petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
+            petsc::options::set_ours("-mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
+        } else {
+            // The condensed Jacobian is dense: MUMPS's PORD ordering rejects it, AMD is fine.
+            petsc::options::set_ours("-mat_mumps_icntl_7", "0").map_err(|e| e.to_string())?;
+            // The condensation's 3D Cholesky has its own prefix and keeps PORD.
+            petsc::options::set_default("-elastic_mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
+        }
+        let t0 = std::time::Instant::now();
+        let comp = if rigid {
+            ctx.log(format!("rigid solids: no elastic unknowns, H = H0 + (X^2 + Z^2)/2; sparse Newton on {} pressure unknowns", p_nodes.len()));
+            Some(crate::solid::condense::Compliance::rigid(mesh.contact_nodes.clone(), p_nodes))
+        } else if monolithic {
+            None
+        } else {
+            ctx.log(format!("coupling: condensed (reynolds.coupling = \"{}\", {} pressure unknowns): the elastic block eliminated onto the contact face, a dense LU at every Newton step", scene.reynolds.coupling, p_nodes.len()));
+            let eq = scene.equivalent_solid();
+            let comp = crate::solid::condense::face_compliance(&ctx.world, mesh, eq.nu, assembly::traction_factor(eq.nu), &p_nodes).map_err(|e| e.to_string())?;
+            ctx.log(format!(
+                "elastic block condensed onto the contact face: {} elastic unknowns -> {} face nodes x {} pressure nodes ({:.2} s)",
+                comp.elastic_unknowns,
+                comp.rows.len(),
+                comp.cols.len(),
+                comp.seconds
+            ));
+            Some(comp)
+        };
+        let condensation_s = (!rigid && !monolithic).then(|| t0.elapsed().as_secs_f64());
+        crate::interrupt::check("the elastic condensation")?;
+        Ok(EhlSolver { mesh, part, dofs, layout, half, coupling, comp, condensation_s })
+    }
+
+    /// The coupling this solver uses.
+    pub fn coupling(&self) -> Coupling {
+        self.coupling
+    }
+
+    /// Solves the scene's operating point. `start`: a converged state of a neighbouring
+    /// operating point (monolithic layout, as in [`EhlSolution::x`]); when Newton fails
+    /// from it, the solve starts over from the Hertz start. Collective.
+    pub fn solve(&self, ctx: &Context, scene: &Scene, start: Option<&[f64]>) -> Result<EhlSolution, String> {
+        self.solve_from(ctx, scene, start.map_or(Start::Hertz, Start::Previous))
+    }
+
+    /// Solves the scene's operating point from `start`; when Newton fails from a start
+    /// other than the Hertz start, the solve starts over from the Hertz start (with its
+    /// automatic continuation). Collective.
+    ///
+    /// On the monolithic coupling a start other than the Hertz start first reuses the LU
+    /// over Newton steps (`Policy::reuses_lu`); if that fails, the same start is solved
+    /// again with an LU at every step before the Hertz start is tried.
+    pub fn solve_from(&self, ctx: &Context, scene: &Scene, start: Start) -> Result<EhlSolution, String> {
+        let once = |start: Start, reuse_lu: bool| match &self.comp {
+            None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, reuse_lu),
+            Some(comp) => solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, start),
+        };
+        if !matches!(start, Start::Hertz) {
+            let tries: &[bool] = if self.comp.is_none() { &[true, false] } else { &[false] };
+            for (k, &reuse_lu) in tries.iter().enumerate() {
+                match once(start, reuse_lu) {
+                    Ok(s) => return Ok(s),
+                    Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
+                    Err(e) if k + 1 < tries.len() => ctx.log(format!("Newton from {} with the LU reused over steps failed ({e}); again with an LU at every step", start.label())),
+                    Err(e) => ctx.log(format!("Newton from {} failed ({e}); starting over from the Hertz start", start.label())),
+                }
+            }
+        }
+        once(Start::Hertz, false)
+    }
+}
+
+/// Builds and solves the EHL system of the scene on the given mesh (one operating point).
+#[allow(clippy::too_many_arguments)]
+pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
+    EhlSolver::new(ctx, scene, mesh, part, dofs, layout, half)?.solve(ctx, scene, None)
+}
+
+/// The face nodes that carry a pressure unknown in the condensed system, in
+/// `mesh.contact_nodes` order: every P2 node off the Dirichlet edges.
+fn pressure_nodes(mesh: &Mesh, layout: &Layout) -> Vec<u32> {
+    mesh.contact_nodes.iter().copied().filter(|&n| layout.p[n as usize] >= 0).collect()
+}
+
+/// The condensed path: Newton on (P, H0) with the face compliance `comp`, from the Hertz
+/// start or from a previous state `start` (monolithic layout).
+fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, comp: &crate::solid::condense::Compliance, half: bool, start: Start) -> Result<EhlSolution, String> {
+    let pe = |e: petsc::PetscError| e.to_string();
+    let comm = petsc::comm_world();
+    let eq = scene.equivalent_solid();
+    let t0 = std::time::Instant::now();
+    let mut system = CondensedSystem::new(mesh, comp, ctx.size, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene));
+    let cl = system.layout.clone();
+    system.debug_mesh = Some(mesh);
+    let mut x0 = vec![0.0; cl.total()];
+    let label = match start {
+        Start::Previous(prev) => {
+            for (j, &n) in comp.cols.iter().enumerate() {
+                x0[j] = prev[layout.p[n as usize] as usize];
+            }
+            x0[cl.h0()] = prev[layout.h0 as usize];
+            start.label()
+        }
+        Start::Hertz | Start::Pressure { .. } => {
+            // The pressure and its (condensed) deflection.
+            let (p, hc) = start.pressure(scene);
+            for (j, &n) in comp.cols.iter().enumerate() {
+                let c = mesh.nodes[n as usize];
+                x0[j] = p(c[0], c[2]);
+            }
+            let uy0 = system.uy(&x0);
+            x0[cl.h0()] = start_h0(hc, mesh, &|n| uy0[cl.face_index[n as usize] as usize])?;
+            if comp.is_rigid() && matches!(start, Start::Hertz) {
+                rigid_start(ctx, &mut system, &mut x0, (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]), cl.local(ctx.rank))?;
+                "the rigid start"
+            } else {
+                start.label()
+            }
+        }
+    };
+    let (d_nnz, o_nnz) = system.preallocation();
+    let j = if comp.is_rigid() {
+        Matrix::new_aij(comm, cl.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?
+    } else {
+        let j = Matrix::new_dense(comm, cl.local(ctx.rank), CONDENSED_PREFIX, &d_nnz, &o_nnz).map_err(pe)?;
+        let (rows, cols) = j.dense_fill_block(cl.total()).map_err(pe)?;
+        system.set_fill_block(rows, cols);
+        j
+    };
+    petsc::ksp::set_direct_solver_defaults_for("", &j).map_err(pe)?;
+    let assembly_s = t0.elapsed().as_secs_f64();
+    let t1 = std::time::Instant::now();
+    let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);
+    ctx.log(format!("Newton from {label}: {} unknowns ({} P, 1 H0), {} Jacobian", cl.total(), cl.n_p, if comp.is_rigid() { "sparse" } else { "dense" }));
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, Policy::for_start(&start, false), &j, (lo, hi), cl.local(ctx.rank))?;
+    let solve_s = t1.elapsed().as_secs_f64();
+    // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
+    let uy = system.uy(&out.x);
+    let mut x = vec![0.0; layout.total()];
+    for (j, &n) in comp.cols.iter().enumerate() {
+        x[layout.p[n as usize] as usize] = out.x[j];
+    }
+    for (i, &n) in comp.rows.iter().enumerate() {
+        let d = layout.u[n as usize][1];
+        if d >= 0 {
+            x[d as usize] = uy[i];
+        }
+    }
+    x[layout.h0 as usize] = out.x[cl.h0()];
+    let coupling = if comp.is_rigid() { Coupling::Rigid } else { Coupling::Condensed };
+    Ok(EhlSolution { x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s, coupling })
+}
+
+/// The monolithic path: U, P and H0 in one sparse system, from the Hertz start or from a
+/// previous state `start` (same layout).
+#[allow(clippy::too_many_arguments)]
+fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool, start: Start, reuse_lu: bool) -> Result<EhlSolution, String> {
+    let pe = |e: petsc::PetscError| e.to_string();
+    let comm = petsc::comm_world();
+    let eq = scene.equivalent_solid();
+    let t0 = std::time::Instant::now();
+    let k = assembly::assemble_stiffness(comm, mesh, part, dofs, ctx.rank, eq.nu).map_err(pe)?;
+    let x0 = match start {
+        Start::Previous(prev) => prev.to_vec(),
+        Start::Hertz | Start::Pressure { .. } => {
+            let (p, hc) = start.pressure(scene);
+            let u_dry = elastic_start(comm, ctx, mesh, part, dofs, &k, eq.nu, p).map_err(pe)?;
+            // Initial iterate: the start pressure, its displacement, H0 from the central film.
+            let mut x0 = vec![0.0; layout.total()];
+            for n in 0..mesh.nodes.len() {
+                for c in 0..3 {
+                    let (d, g) = (dofs.node_dof[n][c], layout.u[n][c]);
+                    if d >= 0 {
+                        x0[g as usize] = u_dry[d as usize];
+                    }
+                }
+                let d = layout.p[n];
+                if d >= 0 {
+                    let c = mesh.nodes[n];
+                    x0[d as usize] = p(c[0], c[2]);
+                }
+            }
+            x0[layout.h0 as usize] = start_h0(hc, mesh, &|n| layout.uy(&x0, n))?;
+            x0
+        }
+    };
+    let label = start.label();
+    let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank);
+    let j = Matrix::new_aij(comm, layout.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?;
+    let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene), k).map_err(pe)?;
+    let assembly_s = t0.elapsed().as_secs_f64();
+    let t1 = std::time::Instant::now();
+    ctx.log(format!("Newton from {label}: {} unknowns ({} U, {} P, 1 H0), sparse Jacobian", layout.total(), layout.counts().0, layout.counts().1));
+    if crate::ehl_options::get().check_jacobian {
+        if crate::ehl_options::get().row_scaling {
+            system.scale_rows(&x0).map_err(pe)?;
+        }
+        for (r, c, e) in check_jacobian(&mut system, layout, ctx.rank, &x0, &j).map_err(pe)? {
+            ctx.log(format!("Jacobian check: rows {r:2} cols {c:2}: max |J v - FD| / max |J v| = {e:.3e}"));
+        }
+    }
+    let (lo, hi) = (layout.ranges[ctx.rank], layout.ranges[ctx.rank + 1]);
+    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, Policy::for_start(&start, reuse_lu), &j, (lo, hi), layout.local(ctx.rank))?;
+    let solve_s = t1.elapsed().as_secs_f64();
+    Ok(EhlSolution { x: out.x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s, coupling: Coupling::Monolithic })
+}

@@ -1,0 +1,84 @@
+//! The solver's own PETSc-style options (`-ehl_...`): developer diagnostics and the few
+//! numerical knobs that are not scene keys. They are read once per run through PETSc's
+//! options database (so `-help` lists them and `-options_left` knows them) and kept here
+//! for every module; before they are read (unit tests), the defaults hold.
+use crate::petsc;
+use std::sync::OnceLock;
+
+/// Values of the `-ehl_...` options.
+#[derive(Debug, Clone)]
+pub struct EhlOptions {
+    /// `-ehl_monitor`: per-iteration diagnostics on stderr (residual norms per block, the
+    /// worst residual rows, the film step limiter and its binding node, clipped pressure
+    /// steps, the condensation's phases).
+    pub monitor: bool,
+    /// `-ehl_check_jacobian`: a block-by-block finite-difference check of the monolithic
+    /// Jacobian at the start (the condensed coupling: `-snes_test_jacobian`).
+    pub check_jacobian: bool,
+    /// `-ehl_supg_delta`: factor on the SUPG parameter tau.
+    pub supg_delta: f64,
+    /// `-ehl_pressure_step_floor`: the floor of a Newton step's nodal pressure
+    /// ([`crate::reynolds::cavitation::PRESSURE_STEP_FLOOR`]); None with
+    /// `-ehl_pressure_step_clip false`.
+    pub pressure_step_floor: Option<f64>,
+    /// `-ehl_film_limiter`: the fraction-to-the-boundary limit on the film in each step.
+    pub film_limiter: bool,
+    /// `-ehl_row_scaling`: each Reynolds row scaled by its diagonal at the start of a solve.
+    pub row_scaling: bool,
+    /// `-ehl_skip_plain`: skip plain Newton from the start and go to the continuation
+    /// (tests of the continuation).
+    pub skip_plain: bool,
+    /// `-ehl_fail_point K`: the K-th operating point of a sweep fails (fault injection for
+    /// the sweep's error handling).
+    pub fail_point: Option<usize>,
+    /// `-ehl_plot_font FILE`: TrueType font for the plots.
+    pub plot_font: Option<String>,
+}
+
+impl Default for EhlOptions {
+    fn default() -> Self {
+        EhlOptions {
+            monitor: false,
+            check_jacobian: false,
+            supg_delta: 1.0,
+            pressure_step_floor: Some(crate::reynolds::cavitation::PRESSURE_STEP_FLOOR),
+            film_limiter: true,
+            row_scaling: true,
+            skip_plain: false,
+            fail_point: None,
+            plot_font: None,
+        }
+    }
+}
+
+static OPTIONS: OnceLock<EhlOptions> = OnceLock::new();
+
+/// Reads the `-ehl_...` options from PETSc's database (after PETSc is initialised; once per
+/// process, later calls keep the first values). Collective.
+pub fn read(comm: petsc::ffi::MPI_Comm) -> petsc::Result<&'static EhlOptions> {
+    if let Some(o) = OPTIONS.get() {
+        return Ok(o);
+    }
+    let d = EhlOptions::default();
+    let mut g = petsc::options::Group::begin(comm, "EHL solver options", "EHL")?;
+    let monitor = g.bool("-ehl_monitor", "Print Newton diagnostics per iteration (block residual norms, worst rows, film limiter)", d.monitor)?;
+    let check_jacobian = g.bool("-ehl_check_jacobian", "Check the monolithic Jacobian block by block against finite differences at the start", d.check_jacobian)?;
+    let supg_delta = g.real("-ehl_supg_delta", "Factor on the SUPG parameter tau of the Reynolds element", d.supg_delta)?.unwrap_or(d.supg_delta);
+    let floor_default = crate::reynolds::cavitation::PRESSURE_STEP_FLOOR;
+    let clip = g.bool("-ehl_pressure_step_clip", "Clip a Newton step's nodal pressure at -ehl_pressure_step_floor", true)?;
+    let floor = g.real("-ehl_pressure_step_floor", "Lowest nodal pressure a Newton step may reach (dimensionless, P/p_H)", floor_default)?.unwrap_or(floor_default);
+    let film_limiter = g.bool("-ehl_film_limiter", "Limit each Newton step so that the film keeps a fifth of its thickness at every node", d.film_limiter)?;
+    let row_scaling = g.bool("-ehl_row_scaling", "Scale each Reynolds row by its diagonal at the start of a solve", d.row_scaling)?;
+    let skip_plain = g.bool("-ehl_skip_plain", "Skip plain Newton from the start and go to the continuation (for tests)", d.skip_plain)?;
+    let fail_point = g.int("-ehl_fail_point", "Make the K-th operating point of a sweep fail (fault injection, for tests)", 0)?.filter(|&k| k > 0).map(|k| k as usize);
+    let plot_font = g.string("-ehl_plot_font", "TrueType font file for the plots", crate::output::plot::FONT_PATH)?;
+    g.end()?;
+    let o = EhlOptions { monitor, check_jacobian, supg_delta, pressure_step_floor: clip.then_some(floor), film_limiter, row_scaling, skip_plain, fail_point, plot_font };
+    Ok(OPTIONS.get_or_init(|| o))
+}
+
+/// The options read by [`read`], or the defaults if they were not read.
+pub fn get() -> &'static EhlOptions {
+    static DEFAULTS: OnceLock<EhlOptions> = OnceLock::new();
+    OPTIONS.get().unwrap_or_else(|| DEFAULTS.get_or_init(EhlOptions::default))
+}

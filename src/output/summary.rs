@@ -1,0 +1,241 @@
+//! `summary.json`, typed: [`Summary`] for a lubricated run, [`DrySummary`] for a dry Hertz
+//! run. The solver fills them; mesh sequencing (`--start-from`), the hard suite's checks and
+//! `paper-findings` read [`Summary`] back. The regression runner compares two summaries key
+//! by key as generic JSON, so both are written through [`to_json`] (keys sorted, as before).
+//!
+//! JSON has no NaN: a non-finite number is written as null and read back as NaN.
+use crate::case::Scene;
+use serde::{Deserialize, Deserializer, Serialize};
+
+/// Reads null (a NaN or infinity when written) as NaN.
+fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// The summary of a converged lubricated operating point.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Summary {
+    /// Scene name.
+    pub case: String,
+    /// MPI ranks of the run.
+    pub ranks: usize,
+    pub converged: bool,
+    pub hertz: HertzSummary,
+    pub operating: OperatingSummary,
+    pub kinematics: KinematicsSummary,
+    pub mesh: MeshSummary,
+    pub film: FilmSummary,
+    pub pressure: PressureSummary,
+    /// Moes' dimensionless load and material parameters (null for rigid or isoviscous
+    /// scenes that have none).
+    pub moes: Option<MoesSummary>,
+    pub solver: SolverSummary,
+    pub timing: Timing,
+    /// Peak resident memory of the largest rank (MB).
+    pub peak_rss_mb: f64,
+    /// Which effects were simulated and which were not (see `app::lubricated::effects_report`).
+    pub effects: serde_json::Value,
+    /// The scene as solved (after `--set` overrides).
+    pub scene: Scene,
+    /// With a friction model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionSummary>,
+}
+
+/// Hertz contact of the scene.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+pub struct HertzSummary {
+    pub a_m: f64,
+    pub ph_pa: f64,
+    pub e_prime_pa: f64,
+}
+
+/// The operating point.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct OperatingSummary {
+    pub load_n: f64,
+    pub entrainment_speed_m_s: Option<f64>,
+    pub slide_to_roll: f64,
+    pub tilt_angle_deg: f64,
+}
+
+/// Surface velocities of the kinematics model.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct KinematicsSummary {
+    pub model: String,
+    #[serde(rename = "omega_B_rad_s", deserialize_with = "nan_if_null")]
+    pub omega_b_rad_s: f64,
+    #[serde(rename = "omega_D_rad_s", deserialize_with = "nan_if_null")]
+    pub omega_d_rad_s: f64,
+    #[serde(rename = "U_BO_m_s", deserialize_with = "nan_if_null")]
+    pub u_bo_m_s: f64,
+    #[serde(rename = "U_DO_m_s", deserialize_with = "nan_if_null")]
+    pub u_do_m_s: f64,
+    /// z of the spin pole (m), with spin kinematics.
+    pub spin_centre_z_m: Option<f64>,
+}
+
+/// The mesh.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct MeshSummary {
+    pub elements: usize,
+    pub nodes: usize,
+    pub dofs_total: usize,
+    pub contact_triangles: usize,
+    pub contact_size_a: f64,
+    pub worst_quality: f64,
+    pub worst_quality_measure: String,
+    /// Dry runs only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_aspect_ratio: Option<f64>,
+}
+
+/// Film thickness (m): central, minimum and where, the film constant h0, and Hamrock and
+/// Dowson's formulas for comparison.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct FilmSummary {
+    #[serde(deserialize_with = "nan_if_null")]
+    pub hc_m: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub hm_m: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub hm_x_m: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub hm_z_m: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub h0_m: f64,
+    pub hc_hamrock_dowson_m: Option<f64>,
+    pub hm_hamrock_dowson_m: Option<f64>,
+}
+
+/// Pressure (Pa): maximum and where, minimum of the field and of the nodes, and the load
+/// balance's relative error.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PressureSummary {
+    #[serde(deserialize_with = "nan_if_null")]
+    pub pmax_pa: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub pmax_x_m: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub pmax_z_m: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub pmin_pa: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub pmin_nodes_pa: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub load_error_rel: f64,
+}
+
+/// Moes' parameters M and L.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+pub struct MoesSummary {
+    #[serde(rename = "M")]
+    pub m: f64,
+    #[serde(rename = "L")]
+    pub l: f64,
+}
+
+/// The Newton solve.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SolverSummary {
+    /// Over the whole path.
+    pub newton_iterations: usize,
+    pub snes_reason: String,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub residual_norm: f64,
+    pub dofs_elastic: usize,
+    pub dofs_reynolds: usize,
+    /// Every Newton solve of the path (plain Newton, continuation steps).
+    pub path: Vec<String>,
+    pub half_domain: bool,
+    pub penalty: f64,
+    pub stabilisation: String,
+    /// "condensed", "monolithic" or "rigid".
+    pub coupling: String,
+}
+
+/// Wall time per phase (s).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Timing {
+    pub mesh_s: f64,
+    pub assembly_s: f64,
+    pub solve_s: f64,
+    /// Lubricated runs only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub post_s: Option<f64>,
+    pub total_s: f64,
+    /// Only when the elastic block was condensed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub condensation_s: Option<f64>,
+    /// With a friction model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_s: Option<f64>,
+}
+
+/// Friction on the disc.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct FrictionSummary {
+    pub model: String,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub fx: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub fz: f64,
+    #[serde(rename = "Fx_n", deserialize_with = "nan_if_null")]
+    pub fx_n: f64,
+    #[serde(rename = "Fz_n", deserialize_with = "nan_if_null")]
+    pub fz_n: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub tau_max_pa: f64,
+}
+
+/// The summary of a dry Hertz run.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct DrySummary {
+    pub case: String,
+    pub ranks: usize,
+    pub converged: bool,
+    pub hertz: HertzSummary,
+    pub equivalent_solid: EquivalentSolidSummary,
+    pub mesh: MeshSummary,
+    pub elastic: ElasticSummary,
+    pub timing: Timing,
+    pub peak_rss_mb: f64,
+    pub peak_rss_mb_all_ranks: f64,
+    pub scene: Scene,
+}
+
+/// The equivalent elastic solid.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+pub struct EquivalentSolidSummary {
+    pub e_pa: f64,
+    pub nu: f64,
+}
+
+/// The dry deflection against the half-space solution.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+pub struct ElasticSummary {
+    pub u2_center_m: f64,
+    pub u2_edge_m: f64,
+    pub u2_center_halfspace_m: f64,
+    pub u2_difference_halfspace_m: f64,
+    pub traction_load_error_rel: f64,
+}
+
+/// A summary as JSON (keys sorted; non-finite numbers null).
+pub fn to_json<T: Serialize>(summary: &T) -> Result<serde_json::Value, String> {
+    serde_json::to_value(summary).map_err(|e| format!("cannot encode summary.json: {e}"))
+}
+
+impl Summary {
+    /// Reads a lubricated run's summary from JSON text.
+    pub fn from_json(text: &str) -> Result<Summary, String> {
+        serde_json::from_str(text).map_err(|e| e.to_string())
+    }
+
+    /// Reads `dir/summary.json`.
+    pub fn read(dir: &std::path::Path) -> Result<Summary, String> {
+        let path = dir.join("summary.json");
+        let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        Summary::from_json(&text).map_err(|e| format!("{}: {e}", path.display()))
+    }
+}
