@@ -357,6 +357,10 @@ pub struct Operating {
     /// (0, 90]; default 90 (no ball spin). lambda = 0 is singular and rejected.
     #[serde(default = "default_tilt_angle")]
     pub tilt_angle: f64,
+    /// Coulomb friction coefficient mu of a dry scene's surface traction q = mu p (in +x,
+    /// on the disc) when `effects.surface_traction = "friction"`; default 0.
+    #[serde(default)]
+    pub friction_coefficient: f64,
 }
 
 /// Keys of `[operating]`.
@@ -369,6 +373,8 @@ pub const OPERATING_FIELDS: &[Field] = &[
     f!("tilt_angle", "tilt angle lambda of the ball's rotation axis", "degrees", Kind::Number(Range::LeftOpen(0.0, 90.0)),
         Presence::Default("90"),
         note = "lambda = 0 is singular: the ball spin omega_B = U_BO/(R_B sin lambda) would be infinite"),
+    f!("friction_coefficient", "dry scene: Coulomb coefficient mu of the surface traction q = mu p in +x (effects.surface_traction = \"friction\")", "", Kind::Number(Range::Closed(0.0, 1.0)),
+        Presence::Default("0")),
 ];
 
 // ---------------------------------------------------------------------------------------
@@ -486,6 +492,18 @@ choice_enum! {
     } default = Auto
 }
 
+choice_enum! {
+    /// `effects.surface_traction`: the tangential traction on the contact face in the
+    /// subsurface stress field (`output.subsurface`); the normal problem never sees it.
+    pub enum SurfaceTraction {
+        /// Only the normal pressure loads the solid.
+        Off = "none",
+        /// Also the shear stresses of the friction pass on the disc (lubricated scene), or
+        /// q = mu p in +x (dry scene, mu = `operating.friction_coefficient`).
+        Friction = "friction",
+    } default = Off
+}
+
 /// `[effects]`: which physics is simulated. Every key is optional; the defaults are the
 /// paper's model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -507,6 +525,8 @@ pub struct Effects {
     pub cavitation: CavitationModel,
     /// "auto" | "off"; default "auto".
     pub symmetry: SymmetryMode,
+    /// "none" | "friction"; default "none".
+    pub surface_traction: SurfaceTraction,
 }
 
 /// Keys of `[effects]`.
@@ -566,6 +586,13 @@ pub const EFFECTS_FIELDS: &[Field] = &[
         "",
         Kind::Choice(SymmetryMode::NAMES),
         Presence::Default("\"auto\"")
+    ),
+    f!(
+        "surface_traction",
+        "tangential traction of the subsurface stress field (output.subsurface)",
+        "",
+        Kind::Choice(SurfaceTraction::NAMES),
+        Presence::Default("\"none\"")
     ),
 ];
 
@@ -868,6 +895,9 @@ pub struct OutputSettings {
     /// z (m) of the rolling-direction line along which the friction pass writes its
     /// shear-stress profile (`shear_profile.csv`); default 0 (the centre line).
     pub shear_profile_z: f64,
+    /// Recover the stresses inside the disc below the contact (subsurface.vtu, section
+    /// maps, `subsurface` in summary.json); default false.
+    pub subsurface: bool,
 }
 
 impl Default for OutputSettings {
@@ -878,6 +908,7 @@ impl Default for OutputSettings {
             vtu: true,
             png: true,
             shear_profile_z: 0.0,
+            subsurface: false,
         }
     }
 }
@@ -911,5 +942,12 @@ pub const OUTPUT_FIELDS: &[Field] = &[
         "m",
         Kind::Number(Range::Any),
         Presence::Default("0")
+    ),
+    f!(
+        "subsurface",
+        "recover the stresses in the disc below the contact (one extra elastic solve)",
+        "",
+        Kind::Bool,
+        Presence::Default("false")
     ),
 ];
