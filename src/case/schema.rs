@@ -504,6 +504,17 @@ choice_enum! {
     } default = Off
 }
 
+choice_enum! {
+    /// `output.subsurface_recovery`: how the continuous stress field is recovered from the
+    /// element stresses.
+    pub enum StressRecovery {
+        /// Superconvergent patch recovery (a polynomial fitted around every vertex).
+        Spr = "spr",
+        /// Volume-weighted average of the element values at each node.
+        Average = "average",
+    } default = Spr
+}
+
 /// `[effects]`: which physics is simulated. Every key is optional; the defaults are the
 /// paper's model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -749,6 +760,9 @@ pub struct MeshSettings {
     pub core_size: f64,
     /// Half width of the core square (units of a), default 1.25.
     pub core_half_width: f64,
+    /// Depth of the core (units of a): > 0 refines the box of the core square down to
+    /// this depth (for the subsurface stresses); default 0 (the square on the face).
+    pub core_depth: f64,
     /// Element size in the ring ring_inner <= sqrt(X^2 + Z^2) <= ring_outer around the
     /// Hertz circle (units of a); 0 (default): no ring refinement.
     pub ring_size: f64,
@@ -779,6 +793,7 @@ impl Default for MeshSettings {
             growth: 0.5,
             core_size: 0.0,
             core_half_width: 1.25,
+            core_depth: 0.0,
             ring_size: 0.0,
             ring_inner: 0.75,
             ring_outer: 1.25,
@@ -836,6 +851,13 @@ pub const MESH_FIELDS: &[Field] = &[
         "a",
         Kind::Number(Range::Closed(0.25, 8.0)),
         Presence::Default("1.25")
+    ),
+    f!(
+        "core_depth",
+        "depth of the core box below the face (0: the core square on the face only; > 0 refines the solid below the contact for output.subsurface)",
+        "a",
+        Kind::Number(Range::Closed(0.0, 8.0)),
+        Presence::Default("0")
     ),
     f!(
         "ring_size",
@@ -898,6 +920,8 @@ pub struct OutputSettings {
     /// Recover the stresses inside the disc below the contact (subsurface.vtu, section
     /// maps, `subsurface` in summary.json); default false.
     pub subsurface: bool,
+    /// "spr" | "average"; default "spr".
+    pub subsurface_recovery: StressRecovery,
 }
 
 impl Default for OutputSettings {
@@ -909,6 +933,7 @@ impl Default for OutputSettings {
             png: true,
             shear_profile_z: 0.0,
             subsurface: false,
+            subsurface_recovery: StressRecovery::Spr,
         }
     }
 }
@@ -949,5 +974,12 @@ pub const OUTPUT_FIELDS: &[Field] = &[
         "",
         Kind::Bool,
         Presence::Default("false")
+    ),
+    f!(
+        "subsurface_recovery",
+        "stress recovery: superconvergent patch fit or nodal averaging",
+        "",
+        Kind::Choice(StressRecovery::NAMES),
+        Presence::Default("\"spr\"")
     ),
 ];

@@ -87,6 +87,153 @@ pub fn recover_nodal(
     (sum, evaluated)
 }
 
+/// Superconvergent patch recovery (Zienkiewicz-Zhu) of the element stresses.
+///
+/// For every vertex a polynomial is fitted by least squares to the element stresses at the
+/// 4 points of the degree-2 rule of every tetrahedron sharing the vertex: quadratic (10
+/// terms) when the patch has at least 24 samples, linear otherwise. The vertex value is
+/// the fit at the vertex; a midside node takes the mean of its two vertices' fits there.
+/// Arguments as [`recover_nodal`]; `n_vertices`: the vertices are the nodes `0..n_vertices`.
+#[allow(clippy::too_many_arguments)]
+pub fn recover_spr(
+    nodes: &[[f64; 3]],
+    n_vertices: usize,
+    tets: &[[u32; 10]],
+    verts: &dyn Fn(usize) -> [[f64; 3]; 4],
+    u: &dyn Fn(usize) -> [f64; 30],
+    wanted: &[bool],
+    lambda: f64,
+    mu: f64,
+) -> (Vec<Sym>, usize) {
+    use crate::fem::quadrature::TET4_BARY;
+    use crate::fem::p2tet::TET_EDGES;
+    let n_nodes = nodes.len();
+    // Vertices whose fit is needed: every vertex of a tetrahedron holding a wanted node.
+    let mut fit_vertex = vec![false; n_vertices];
+    for tet in tets {
+        if tet.iter().any(|&n| wanted[n as usize]) {
+            for &v in &tet[..4] {
+                fit_vertex[v as usize] = true;
+            }
+        }
+    }
+    // Vertex -> tetrahedra (CSR) for the fitted vertices.
+    let mut start = vec![0usize; n_vertices + 1];
+    for tet in tets {
+        for &v in &tet[..4] {
+            if fit_vertex[v as usize] {
+                start[v as usize + 1] += 1;
+            }
+        }
+    }
+    for i in 0..n_vertices {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut inc = vec![0u32; start[n_vertices]];
+    for (t, tet) in tets.iter().enumerate() {
+        for &v in &tet[..4] {
+            if fit_vertex[v as usize] {
+                inc[fill[v as usize]] = t as u32;
+                fill[v as usize] += 1;
+            }
+        }
+    }
+    // Sampled stresses of every tetrahedron a fit needs (computed once).
+    let mut samples: std::collections::HashMap<u32, [([f64; 3], Sym); 4]> = std::collections::HashMap::new();
+    let mut evaluated = 0;
+    let mut sample = |t: u32| -> [([f64; 3], Sym); 4] {
+        *samples.entry(t).or_insert_with(|| {
+            evaluated += 1;
+            let v = verts(t as usize);
+            let ue = u(t as usize);
+            TET4_BARY.map(|l| {
+                let x: [f64; 3] = std::array::from_fn(|c| (0..4).map(|k| l[k] * v[k][c]).sum());
+                (x, element_stress(&v, &ue, l, lambda, mu))
+            })
+        })
+    };
+    // Fitted polynomial coefficients per vertex: (centre, scale, coefficients per component).
+    type Fit = ([f64; 3], f64, Vec<[f64; 6]>);
+    let basis = |d: [f64; 3], quadratic: bool| -> Vec<f64> {
+        let mut b = vec![1.0, d[0], d[1], d[2]];
+        if quadratic {
+            b.extend([d[0] * d[0], d[1] * d[1], d[2] * d[2], d[0] * d[1], d[1] * d[2], d[0] * d[2]]);
+        }
+        b
+    };
+    let mut fits: Vec<Option<Fit>> = vec![None; n_vertices];
+    for v in 0..n_vertices {
+        if !fit_vertex[v] {
+            continue;
+        }
+        let patch = &inc[start[v]..start[v + 1]];
+        let pts: Vec<([f64; 3], Sym)> = patch.iter().flat_map(|&t| sample(t)).collect();
+        let c = nodes[v];
+        let scale = pts.iter().map(|(x, _)| (0..3).map(|k| (x[k] - c[k]).abs()).fold(0.0, f64::max)).fold(1e-300, f64::max);
+        // Quadratic when the patch determines it (well conditioned), linear otherwise (a
+        // patch on the boundary may leave a quadratic vanishing at every sample).
+        let mut fitted = None;
+        for quadratic in [true, false] {
+            let nb = if quadratic { 10 } else { 4 };
+            if pts.len() < nb || (quadratic && pts.len() < 24) {
+                continue;
+            }
+            let mut ata = nalgebra::DMatrix::<f64>::zeros(nb, nb);
+            let mut atb = nalgebra::DMatrix::<f64>::zeros(nb, 6);
+            for (x, s) in &pts {
+                let b = basis(std::array::from_fn(|k| (x[k] - c[k]) / scale), quadratic);
+                for i in 0..nb {
+                    for j in 0..nb {
+                        ata[(i, j)] += b[i] * b[j];
+                    }
+                    for k in 0..6 {
+                        atb[(i, k)] += b[i] * s[k];
+                    }
+                }
+            }
+            let svd = ata.svd(true, true);
+            let smax = svd.singular_values.iter().fold(0.0f64, |a, &b| a.max(b));
+            let smin = svd.singular_values.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+            if smin < 1e-8 * smax {
+                continue;
+            }
+            if let Ok(coef) = svd.solve(&atb, 0.0) {
+                fitted = Some((0..nb).map(|i| std::array::from_fn(|k| coef[(i, k)])).collect::<Vec<[f64; 6]>>());
+                break;
+            }
+        }
+        let Some(coefs) = fitted else { continue };
+        fits[v] = Some((c, scale, coefs));
+    }
+    let eval = |f: &Fit, x: [f64; 3]| -> Sym {
+        let (c, scale, coefs) = f;
+        let b = basis(std::array::from_fn(|k| (x[k] - c[k]) / scale), coefs.len() == 10);
+        std::array::from_fn(|k| (0..coefs.len()).map(|i| b[i] * coefs[i][k]).sum())
+    };
+    let mut out = vec![[0.0; 6]; n_nodes];
+    let mut done = vec![false; n_nodes];
+    for tet in tets {
+        if !tet.iter().any(|&n| wanted[n as usize]) {
+            continue;
+        }
+        for k in 0..10 {
+            let n = tet[k] as usize;
+            if !wanted[n] || done[n] {
+                continue;
+            }
+            let ends: Vec<usize> = if k < 4 { vec![n] } else { TET_EDGES[k - 4].iter().map(|&i| tet[i] as usize).collect() };
+            let vals: Vec<Sym> = ends.iter().filter_map(|&v| fits[v].as_ref().map(|f| eval(f, nodes[n]))).collect();
+            if vals.is_empty() {
+                continue;
+            }
+            out[n] = std::array::from_fn(|c| vals.iter().map(|s| s[c]).sum::<f64>() / vals.len() as f64);
+            done[n] = true;
+        }
+    }
+    (out, evaluated)
+}
+
 /// The P2 interpolant of 10 nodal tensors at barycentric coordinates `bary`.
 pub fn eval_p2(nodal: &[Sym; 10], bary: [f64; 4]) -> Sym {
     let n = p2_tet_basis_bary(bary);
@@ -213,6 +360,20 @@ mod tests {
         let e = stress_from_grad(&field(x).1, l, m);
         let r = eval_p2(&nodal, b);
         assert!((r[2] - e[2][2]).abs() < 1e-12 && (r[5] - e[0][2]).abs() < 1e-12);
+        // The patch recovery reproduces a linear field too (a polynomial of its basis).
+        let (s, _) = recover_spr(&nodes, vertex_count(&tets), &tets, &verts, &u, &wanted, l, m);
+        for (n, x) in nodes.iter().enumerate() {
+            let e = stress_from_grad(&field(*x).1, l, m);
+            assert!((s[n][0] - e[0][0]).abs() < 1e-10 && (s[n][4] - e[1][2]).abs() < 1e-10, "SPR node {n}: {:?}", s[n]);
+        }
+    }
+
+    /// kuhn_box_mesh numbers the vertices first? Count the nodes that are tet corners and
+    /// check they are the first ones.
+    fn vertex_count(tets: &[[u32; 10]]) -> usize {
+        let nv = tets.iter().flat_map(|t| t[..4].iter()).map(|&v| v as usize + 1).max().unwrap();
+        assert!(tets.iter().all(|t| t[4..].iter().all(|&m| m as usize >= nv)), "vertices first");
+        nv
     }
 
     #[test]
