@@ -85,11 +85,11 @@ fn subsurface_stresses(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &mesh::P
         let x = Vector::new(comm, dofs.local(ctx.rank)).map_err(pe)?;
         ksp.solve(&b, &x).map_err(pe)?;
         let sol = x.gather_all().map_err(pe)?;
-        let cost = sub::SolveCost { seconds: t0.elapsed().as_secs_f64(), rss_increase_mb: sub::current_rss_mb() - rss0, unknowns: dofs.total() };
+        let cost = sub::SolveCost { seconds: t0.elapsed().as_secs_f64(), rss_increase_mb: sub::current_rss_mb() - rss0, factor_mb: ksp.mumps_factor_mb(), unknowns: dofs.total() };
         (Some(sub::node_displacements(dofs, &sol, 1.0)), cost)
     } else if ctx.rank == 0 {
-        let (u, c) = sub::solve_alone(mesh, disc.nu, &load)?;
-        (Some(u), c)
+        let (mut u, c) = sub::solve_alone(mesh, disc.nu, &[&load])?;
+        (u.pop(), c)
     } else {
         (None, sub::SolveCost::default())
     };
@@ -116,7 +116,7 @@ fn subsurface_stresses(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &mesh::P
     obj["friction_coefficient"] = json!(mu);
     obj["solve"] = json!({
         "kind": if reuse { "the main solve's factorisation, one more right-hand side" } else { "rank 0: the disc's own elastic problem (MUMPS Cholesky)" },
-        "seconds": cost.seconds, "rss_increase_mb": cost.rss_increase_mb, "unknowns": cost.unknowns,
+        "seconds": cost.seconds, "rss_increase_mb": cost.rss_increase_mb, "mumps_factor_mb": cost.factor_mb, "unknowns": cost.unknowns,
         "main_solve_s": main_solve_s,
     });
     obj["total_s"] = json!(t0.elapsed().as_secs_f64());

@@ -9,6 +9,7 @@
 //! units of p_H, so the stress comes out in units of p_H (the stress of a body loaded by
 //! tractions depends on its Poisson ratio only) and the displacement in units of
 //! a p_H / E_disc.
+#![allow(clippy::needless_range_loop)]
 use crate::fem::elasticity::lame;
 use crate::mesh::{partition, Mesh, Partition, Rect};
 use crate::output::vtu::{write_vtu_single_type, Field, VTK_QUADRATIC_TETRA};
@@ -61,12 +62,18 @@ pub fn node_displacements(dofs: &DofMap, sol: &[f64], scale: f64) -> Vec<[f64; 3
     dofs.node_dof.iter().map(|d| d.map(|i| if i < 0 { 0.0 } else { scale * sol[i as usize] })).collect()
 }
 
+/// A displacement `[u_x, u_y, u_z]` per mesh node.
+pub type NodeField = Vec<[f64; 3]>;
+
 /// Cost of the extra elastic solve.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SolveCost {
     pub seconds: f64,
-    /// Resident memory added while the factorisation was alive (MB).
+    /// Resident memory added while the factorisation was alive (MB; freed memory the
+    /// allocator reuses does not show).
     pub rss_increase_mb: f64,
+    /// Memory of the MUMPS factorisation (MB, INFOG(22)).
+    pub factor_mb: Option<f64>,
     pub unknowns: usize,
 }
 
@@ -84,8 +91,9 @@ pub fn current_rss_mb() -> f64 {
 pub const PREFIX: &str = "subsurface_";
 
 /// Solves the elastic problem of the disc (unit Young's modulus, Poisson ratio `nu`) under
-/// the face traction `load`, on this rank alone (MUMPS Cholesky on PETSC_COMM_SELF).
-pub fn solve_alone(mesh: &Mesh, nu: f64, load: &FaceLoad) -> Result<(Vec<[f64; 3]>, SolveCost), String> {
+/// each face traction of `loads`, on this rank alone (one MUMPS Cholesky on
+/// PETSC_COMM_SELF, one back substitution per load). The cost covers the first load.
+pub fn solve_alone(mesh: &Mesh, nu: f64, loads: &[&FaceLoad]) -> Result<(Vec<NodeField>, SolveCost), String> {
     let pe = |e: petsc::PetscError| format!("subsurface elastic solve: {e}");
     let t0 = Instant::now();
     let rss0 = current_rss_mb();
@@ -94,18 +102,23 @@ pub fn solve_alone(mesh: &Mesh, nu: f64, load: &FaceLoad) -> Result<(Vec<[f64; 3
     let dofs = DofMap::new(mesh, &part, 1);
     let k = assemble_stiffness(selfc, mesh, &part, &dofs, 0, nu).map_err(pe)?;
     unsafe { ffi::MatSetOption(k.raw(), ffi::MatOption_MAT_SPD, ffi::PetscBool_PETSC_TRUE) };
-    let b = assemble_face_traction(selfc, mesh, &part, &dofs, 0, load).map_err(pe)?;
     petsc::options::set_default(&format!("-{PREFIX}ksp_type"), "preonly").map_err(pe)?;
     petsc::options::set_default(&format!("-{PREFIX}pc_type"), "cholesky").map_err(pe)?;
     petsc::options::set_default(&format!("-{PREFIX}pc_factor_mat_solver_type"), "mumps").map_err(pe)?;
     petsc::options::set_default(&format!("-{PREFIX}mat_mumps_icntl_7"), "4").map_err(pe)?;
     let ksp = Ksp::with_prefix(selfc, &k, PREFIX).map_err(pe)?;
-    let x = Vector::new(selfc, dofs.local(0)).map_err(pe)?;
-    ksp.solve(&b, &x).map_err(pe)?;
-    let rss1 = current_rss_mb();
-    let sol = x.local_values().map_err(pe)?;
-    let cost = SolveCost { seconds: t0.elapsed().as_secs_f64(), rss_increase_mb: rss1 - rss0, unknowns: dofs.total() };
-    Ok((node_displacements(&dofs, &sol, 1.0), cost))
+    let mut out = Vec::new();
+    let mut cost = SolveCost::default();
+    for (i, load) in loads.iter().enumerate() {
+        let b = assemble_face_traction(selfc, mesh, &part, &dofs, 0, load).map_err(pe)?;
+        let x = Vector::new(selfc, dofs.local(0)).map_err(pe)?;
+        ksp.solve(&b, &x).map_err(pe)?;
+        if i == 0 {
+            cost = SolveCost { seconds: t0.elapsed().as_secs_f64(), rss_increase_mb: current_rss_mb() - rss0, factor_mb: ksp.mumps_factor_mb(), unknowns: dofs.total() };
+        }
+        out.push(node_displacements(&dofs, &x.local_values().map_err(pe)?, 1.0));
+    }
+    Ok((out, cost))
 }
 
 /// What the recovery needs besides the mesh and the displacement.
@@ -248,6 +261,30 @@ impl<'a> Recovered<'a> {
         ext
     }
 
+    /// The maximum of `f` on the plane z = `zc` within `radius` of (x, y) (units of a): a
+    /// lattice of step 0.01 a, refined with step 0.002 a around the best point.
+    pub fn maximum_on_plane(&self, f: &dyn Fn(&Sym) -> f64, zc: f64, around: [f64; 2], radius: f64) -> Option<Extremum> {
+        let mut best: Option<Extremum> = None;
+        let scan = |c: [f64; 2], r: f64, h: f64, best: &mut Option<Extremum>| {
+            let n = (r / h).round() as i64;
+            for i in -n..=n {
+                for j in -n..=n {
+                    let p = [c[0] + i as f64 * h, (c[1] + j as f64 * h).min(0.0), zc];
+                    if let Some(s) = self.at(p) {
+                        let v = f(&s);
+                        if best.as_ref().map_or(true, |b| v > b.value) {
+                            *best = Some(Extremum { value: v, at: p, stress: s });
+                        }
+                    }
+                }
+            }
+        };
+        scan(around, radius, 0.01, &mut best);
+        let c = best.as_ref().map(|b| [b.at[0], b.at[1]])?;
+        scan(c, 0.02, 0.002, &mut best);
+        best
+    }
+
     /// Triangles of the section of the region by the plane `coordinate[axis] = c` (in the
     /// plane's 2D coordinates (`plane` picks them) and values of `f` at their corners),
     /// each cut polygon split into triangles and each triangle into 4 (P2 values at the
@@ -328,6 +365,11 @@ pub fn recover_and_write(mesh: &Mesh, u: &[[f64; 3]], p: &Params, dir: &Path, lo
     extremum_json("tau_xy_max", &txy, a, ph, &mut obj);
     obj.insert("tau_xy_max_signed_pa".into(), json!(tau_xy(&txy.stress) * ph));
     extremum_json("compression_max", &pmin, a, ph, &mut obj);
+    // The von Mises maximum on the plane z = 0 through the contact centre (the plane of the
+    // x-y maps; the plane of symmetry of a symmetric load), searched near the 3D maximum.
+    if let Some(e) = rec.maximum_on_plane(&von_mises, 0.0, [vm.at[0], vm.at[1]], 0.3) {
+        extremum_json("von_mises_max_z0", &e, a, ph, &mut obj);
+    }
     log(format!(
         "subsurface ({}): von Mises max {:.4e} Pa at ({:.3}a, depth {:.3}a, {:.3}a); Tresca max {:.4e} Pa at depth {:.3}a; |tau_xy| max {:.4e} Pa at ({:.3}a, depth {:.3}a)",
         p.traction, vm.value * ph, vm.at[0], -vm.at[1], vm.at[2], tr.value * ph, -tr.at[1], txy.value * ph, txy.at[0], -txy.at[1]
@@ -357,6 +399,19 @@ pub fn recover_and_write(mesh: &Mesh, u: &[[f64; 3]], p: &Params, dir: &Path, lo
     obj.insert("output_s".into(), json!(t1.elapsed().as_secs_f64()));
     obj.insert("tetrahedra_evaluated".into(), json!(rec.evaluated));
     Ok(serde_json::Value::Object(obj))
+}
+
+/// The maxima of a second load case (no outputs): the `subsurface` object's maxima keys.
+pub fn maxima_only(mesh: &Mesh, u: &[[f64; 3]], p: &Params) -> serde_json::Value {
+    let rec = Recovered::new(mesh, u, p.nu, &p.rect, p.method);
+    let mut obj = serde_json::Map::new();
+    obj.insert("surface_traction".into(), json!(p.traction));
+    extremum_json("von_mises_max", &rec.maximum(&von_mises), p.a, p.ph, &mut obj);
+    extremum_json("tresca_max", &rec.maximum(&tresca), p.a, p.ph, &mut obj);
+    let txy = rec.maximum(&|s: &Sym| tau_xy(s).abs());
+    extremum_json("tau_xy_max", &txy, p.a, p.ph, &mut obj);
+    obj.insert("tau_xy_max_signed_pa".into(), json!(tau_xy(&txy.stress) * p.ph));
+    serde_json::Value::Object(obj)
 }
 
 fn write_region_vtu(rec: &Recovered, u: &[[f64; 3]], p: &Params, path: &Path) -> Result<(), String> {

@@ -260,6 +260,12 @@ impl Scene {
                 .into());
             }
         }
+        if self.output.subsurface && e.elasticity == ElasticityModel::Rigid {
+            return Err(SceneErrorKind::Conflict(
+                "output.subsurface = true needs the elastic solid, but effects.elasticity = \"rigid\" has no 3D mesh (set effects.elasticity = \"elastic\" or output.subsurface = false)".into(),
+            )
+            .into());
+        }
         if e.surface_traction == SurfaceTraction::Friction {
             if e.lubrication == LubricationModel::Reynolds && e.friction == FrictionModel::Off {
                 return Err(SceneErrorKind::Conflict(

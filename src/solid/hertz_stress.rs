@@ -118,7 +118,41 @@ pub fn hamilton_sliding(x: f64, y: f64, z: f64, nu: f64, mu: f64) -> Stress6 {
     std::array::from_fn(|k| n[k] + mu * t[k])
 }
 
+/// Von Mises stress of a tensor `[xx, yy, zz, xy, yz, xz]`.
+pub fn von_mises(s: &Stress6) -> f64 {
+    let d = (s[0] - s[1]).powi(2) + (s[1] - s[2]).powi(2) + (s[2] - s[0]).powi(2);
+    (0.5 * d + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5])).sqrt()
+}
+
+/// The largest von Mises stress of the sliding contact (units of p0) and where it is,
+/// `(value, x, z)` (units of a) on the plane of symmetry y = 0: a lattice search on
+/// |x| <= 1.5, 0 <= z <= 1.5 (step 0.01), refined twice around the best point (steps
+/// 0.001 and 0.0001).
+pub fn sliding_von_mises_max(nu: f64, mu: f64) -> (f64, f64, f64) {
+    let f = |x: f64, z: f64| von_mises(&hamilton_sliding(x, 0.0, z.max(0.0), nu, mu));
+    let mut best = (f64::NEG_INFINITY, 0.0, 0.0);
+    let scan = |x0: f64, x1: f64, z0: f64, z1: f64, h: f64, best: &mut (f64, f64, f64)| {
+        let (nx, nz) = (((x1 - x0) / h).round() as i64, ((z1 - z0) / h).round() as i64);
+        for i in 0..=nx {
+            for j in 0..=nz {
+                let (x, z) = (x0 + i as f64 * h, (z0 + j as f64 * h).max(0.0));
+                let v = f(x, z);
+                if v > best.0 {
+                    *best = (v, x, z);
+                }
+            }
+        }
+    };
+    scan(-1.5, 1.5, 0.0, 1.5, 0.01, &mut best);
+    for h in [0.001, 0.0001] {
+        let (x, z) = (best.1, best.2);
+        scan(x - 15.0 * h, x + 15.0 * h, z - 15.0 * h, z + 15.0 * h, h, &mut best);
+    }
+    best
+}
+
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
 
@@ -218,6 +252,14 @@ mod tests {
             let t = hamilton_tangential(1e-3, 0.0, z, NU);
             let t0 = hamilton_tangential(0.0, 0.0, z, NU);
             assert!((t[5] - t0[5]).abs() < 1e-4, "z = {z}: {} vs {}", t[5], t0[5]);
+        }
+    }
+
+    #[test]
+    fn sliding_maxima() {
+        for mu in [0.0, 0.1, 0.2, 0.3, 0.4, 0.5] {
+            let (v, x, z) = sliding_von_mises_max(NU, mu);
+            eprintln!("mu = {mu}: von Mises max {v:.4} p0 at x = {x:.4} a, z = {z:.4} a");
         }
     }
 
