@@ -12,7 +12,15 @@ const NU: f64 = 0.3;
 fn run_dry(name: &str, extra: &[&str]) -> (std::path::PathBuf, serde_json::Value) {
     let dir = scratch(name);
     let scene = repo().join("cases/dry-hertz.toml");
-    let mut args = vec![scene.to_str().unwrap(), "--output", dir.to_str().unwrap(), "--set", "output.subsurface=true", "--set", "effects.friction=none"];
+    let mut args = vec![
+        scene.to_str().unwrap(),
+        "--output",
+        dir.to_str().unwrap(),
+        "--set",
+        "output.subsurface=true",
+        "--set",
+        "effects.friction=none",
+    ];
     args.extend_from_slice(extra);
     let out = mpirun(1, &args);
     assert!(out.status.success(), "{name} failed:\n{}", text(&out));
@@ -39,8 +47,14 @@ fn dry_hertz_subsurface_matches_huber() {
         let (sz, sr) = huber_axis(d, NU);
         let tol = if d < 0.1 { 0.025 } else { 0.015 };
         let (sxx, syy, szz) = (v[1] / ph, v[2] / ph, v[3] / ph);
-        assert!((syy - sz).abs() < tol, "depth {d:.3} a: sigma_y = {syy:.4} p_H, Huber {sz:.4}");
-        assert!((sxx - sr).abs() < tol && (szz - sr).abs() < tol, "depth {d:.3} a: sigma_x = {sxx:.4}, sigma_z = {szz:.4} p_H, Huber sigma_r {sr:.4}");
+        assert!(
+            (syy - sz).abs() < tol,
+            "depth {d:.3} a: sigma_y = {syy:.4} p_H, Huber {sz:.4}"
+        );
+        assert!(
+            (sxx - sr).abs() < tol && (szz - sr).abs() < tol,
+            "depth {d:.3} a: sigma_x = {sxx:.4}, sigma_z = {szz:.4} p_H, Huber sigma_r {sr:.4}"
+        );
         rows += 1;
     }
     assert!(rows > 150, "only {rows} axis samples above 2a");
@@ -56,12 +70,24 @@ fn dry_hertz_subsurface_matches_huber() {
     }
     let tau = 0.5 * num(&s, "subsurface.tresca_max_pa") / ph;
     let depth = num(&s, "subsurface.tresca_max_depth_m") / a;
-    assert!((tau / tmax - 1.0).abs() < 0.01, "max shear {tau:.4} p_H vs Huber {tmax:.4} p_H");
-    assert!((depth - zmax).abs() < 0.03, "max shear at depth {depth:.3} a vs Huber {zmax:.3} a");
+    assert!(
+        (tau / tmax - 1.0).abs() < 0.01,
+        "max shear {tau:.4} p_H vs Huber {tmax:.4} p_H"
+    );
+    assert!(
+        (depth - zmax).abs() < 0.03,
+        "max shear at depth {depth:.3} a vs Huber {zmax:.3} a"
+    );
     // The maximum lies on the axis (the load is axisymmetric).
     let r = num(&s, "subsurface.tresca_max_x_m").hypot(num(&s, "subsurface.tresca_max_z_m")) / a;
     assert!(r < 0.1, "max shear {r:.3} a off the axis");
-    for f in ["subsurface.vtu", "subsurface_von_mises_xy.png", "subsurface_von_mises_zy.png", "subsurface_tau_xy_xy.png", "subsurface_tau_xy_zy.png"] {
+    for f in [
+        "subsurface.vtu",
+        "subsurface_von_mises_xy.png",
+        "subsurface_von_mises_zy.png",
+        "subsurface_tau_xy_xy.png",
+        "subsurface_tau_xy_zy.png",
+    ] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
     // One more right-hand side on the main factorisation: far cheaper than the solve.
@@ -73,17 +99,41 @@ fn dry_hertz_subsurface_matches_huber() {
 /// Hamilton's (x, y, z) to (x, z, -y)).
 fn check_hamilton(mu: f64) {
     let m = mu.to_string();
-    let (_, s) = run_dry(&format!("subsurface-hamilton-{m}"), &["--set", "effects.surface_traction=friction", "--set", &format!("operating.friction_coefficient={m}"), "--set", "output.png=false", "--set", "output.vtu=false"]);
+    let (_, s) = run_dry(
+        &format!("subsurface-hamilton-{m}"),
+        &[
+            "--set",
+            "effects.surface_traction=friction",
+            "--set",
+            &format!("operating.friction_coefficient={m}"),
+            "--set",
+            "output.png=false",
+            "--set",
+            "output.vtu=false",
+        ],
+    );
     let (a, ph) = (num(&s, "hertz.a_m"), num(&s, "hertz.ph_pa"));
     let (vref, xref, zref) = sliding_von_mises_max(NU, mu);
     let v = num(&s, "subsurface.von_mises_max_z0_pa") / ph;
-    let (x, d) = (num(&s, "subsurface.von_mises_max_z0_x_m") / a, num(&s, "subsurface.von_mises_max_z0_depth_m") / a);
+    let (x, d) = (
+        num(&s, "subsurface.von_mises_max_z0_x_m") / a,
+        num(&s, "subsurface.von_mises_max_z0_depth_m") / a,
+    );
     eprintln!("mu = {mu}: von Mises max {v:.4} p_H at x = {x:.4} a, depth {d:.4} a; Hamilton {vref:.4} at x = {xref:.4} a, depth {zref:.4} a");
-    assert!((v / vref - 1.0).abs() < 0.02, "mu = {mu}: von Mises max {v:.4} p_H vs Hamilton {vref:.4}");
-    assert!((x - xref).abs() < 0.05 && (d - zref).abs() < 0.05, "mu = {mu}: maximum at ({x:.3}, depth {d:.3}) a vs Hamilton ({xref:.3}, {zref:.3}) a");
+    assert!(
+        (v / vref - 1.0).abs() < 0.02,
+        "mu = {mu}: von Mises max {v:.4} p_H vs Hamilton {vref:.4}"
+    );
+    assert!(
+        (x - xref).abs() < 0.05 && (d - zref).abs() < 0.05,
+        "mu = {mu}: maximum at ({x:.3}, depth {d:.3}) a vs Hamilton ({xref:.3}, {zref:.3}) a"
+    );
     // Over the whole region the maximum is the same (the plane of symmetry holds it).
     let v3 = num(&s, "subsurface.von_mises_max_pa") / ph;
-    assert!((v3 / v - 1.0).abs() < 0.01, "3D maximum {v3:.4} vs plane {v:.4}");
+    assert!(
+        (v3 / v - 1.0).abs() < 0.01,
+        "3D maximum {v3:.4} vs plane {v:.4}"
+    );
 }
 
 #[test]
