@@ -145,3 +145,64 @@ fn sliding_hertz_mu_0_1_matches_hamilton() {
 fn sliding_hertz_mu_0_3_matches_hamilton() {
     check_hamilton(0.3);
 }
+
+/// The lubricated path on a small, lightly loaded scene (minimal.toml at L = 100 N, h_c =
+/// 0.5 a, SRR = 5 %): the files, the pressure-only maxima next to the friction ones, and
+/// the surface traction seen by the recovered field: the largest compression is the
+/// largest film pressure (within 10 % on this coarse mesh: the P2 stress at the face) and
+/// the friction traction (fx about 0.008) changes the von Mises maximum by less than 2 %.
+#[test]
+fn lubricated_subsurface_outputs() {
+    let dir = scratch("subsurface-lubricated");
+    let scene = repo().join("cases/examples/minimal.toml");
+    let args = [
+        scene.to_str().unwrap(),
+        "--output",
+        dir.to_str().unwrap(),
+        "--set",
+        "output.subsurface=true",
+        "--set",
+        "effects.surface_traction=friction",
+        "--set",
+        "mesh.contact_size=0.5",
+        "--set",
+        "operating.load=100",
+        "--set",
+        "operating.entrainment_speed=5",
+        "--set",
+        "operating.slide_to_roll=0.05",
+    ];
+    let out = mpirun(2, &args);
+    assert!(
+        out.status.success(),
+        "lubricated subsurface run failed:\n{}",
+        text(&out)
+    );
+    let s = summary(&dir);
+    for f in [
+        "subsurface.vtu",
+        "subsurface_axis.csv",
+        "subsurface_von_mises_xy.png",
+        "subsurface_tau_xy_zy.png",
+    ] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    let pmax = num(&s, "pressure.pmax_pa");
+    let comp = num(&s, "subsurface.compression_max_pa");
+    assert!(
+        (comp / pmax - 1.0).abs() < 0.1,
+        "largest compression {comp:.4e} Pa vs pmax {pmax:.4e} Pa"
+    );
+    let (vm, vm0) = (
+        num(&s, "subsurface.von_mises_max_pa"),
+        num(&s, "subsurface.pressure_only.von_mises_max_pa"),
+    );
+    assert!(
+        vm != vm0 && (vm / vm0 - 1.0).abs() < 0.02,
+        "von Mises max {vm:.4e} with friction, {vm0:.4e} without"
+    );
+    assert!(
+        num(&s, "subsurface.solve.seconds") > 0.0
+            && num(&s, "subsurface.solve.mumps_factor_mb") > 0.0
+    );
+}
