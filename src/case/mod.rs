@@ -321,6 +321,9 @@ impl Scene {
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();
         let e = &self.effects;
+        if self.mesh.core_depth > 0.0 && self.mesh.core_size == 0.0 {
+            w.push("mesh.core_depth is given but mesh.core_size = 0: there is no core to deepen".into());
+        }
         if e.surface_traction == SurfaceTraction::Friction && !self.output.subsurface {
             w.push("effects.surface_traction = \"friction\" only loads the subsurface stress field, which output.subsurface = false does not compute".into());
         }

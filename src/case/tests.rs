@@ -683,4 +683,6 @@ fn subsurface_keys_are_checked_together() {
     // A friction traction that nothing computes is a warning.
     let s = parse_scene(&paper_with("friction = \"ree-eyring\"", "friction = \"ree-eyring\"\nsurface_traction = \"friction\""), "t").unwrap();
     assert!(s.warnings().iter().any(|w| w.contains("output.subsurface")), "{:?}", s.warnings());
+    let s = parse_scene(&paper_with("[output]", "[output]\nsubsurface = true").replace("growth = ", "core_depth = 1.0\ngrowth = "), "t").unwrap();
+    assert!(s.warnings().iter().any(|w| w.contains("mesh.core_depth")), "{:?}", s.warnings());
 }
