@@ -366,10 +366,34 @@ mod tests {
 
     #[test]
     fn sliding_maxima() {
-        for mu in [0.0, 0.1, 0.2, 0.3, 0.4, 0.5] {
-            let (v, x, z) = sliding_von_mises_max(NU, mu);
-            eprintln!("mu = {mu}: von Mises max {v:.4} p0 at x = {x:.4} a, z = {z:.4} a");
+        // Frictionless: on the axis von Mises is |sigma_r - sigma_z|, twice Huber's
+        // largest shear stress (0.3100 p0 at 0.481 a).
+        let (v, x, z) = sliding_von_mises_max(NU, 0.0);
+        let (sz, sr) = huber_axis(z, NU);
+        assert!(
+            x.abs() < 1e-3 && (v - (sr - sz).abs()).abs() < 1e-6,
+            "{v} at ({x}, {z})"
+        );
+        assert!(
+            (v - 0.62).abs() < 0.001 && (z - 0.481).abs() < 0.002,
+            "{v} at z = {z}"
+        );
+        // Friction pulls the maximum forward and up, and above mu ~ 0.3 it jumps to the
+        // trailing edge of the surface (tension and traction add up there).
+        let mut last = (v, x, z);
+        for mu in [0.1, 0.2, 0.3] {
+            let m = sliding_von_mises_max(NU, mu);
+            assert!(
+                m.0 > last.0 && m.1 > last.1 && m.2 < last.2 && m.2 > 0.3,
+                "mu = {mu}: {m:?}"
+            );
+            last = m;
         }
+        let (_, x, z) = sliding_von_mises_max(NU, 0.4);
+        assert!(
+            z == 0.0 && (x + 1.0).abs() < 0.01,
+            "mu = 0.4: maximum at ({x}, {z})"
+        );
     }
 
     /// Johnson: the largest shear stress on the axis is 0.31 p0 at z = 0.48 a (nu = 0.3).
