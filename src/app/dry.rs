@@ -6,6 +6,7 @@ use crate::case::Scene;
 use crate::mesh::{self, Mesh};
 use crate::petsc::{self, Ksp, Vector};
 use crate::solid::{assembly, dofmap::DofMap, hertz_load};
+use serde_json::json;
 use std::time::Instant;
 
 /// Depth of the recursive splitting of contact triangles cut by the Hertz circle.
@@ -29,6 +30,7 @@ pub fn mesh_spec(scene: &Scene, half_z: bool) -> mesh::MeshSpec {
             let w = scene.mesh.core_half_width;
             (mesh::Rect { x0: -w, x1: w, z0: -w, z1: if half_z { 0.0 } else { w } }, scene.mesh.core_size)
         }),
+        core_depth: scene.mesh.core_depth,
         ring: (scene.mesh.ring_size > 0.0).then_some(mesh::Ring {
             inner: scene.mesh.ring_inner,
             outer: scene.mesh.ring_outer,
@@ -52,6 +54,75 @@ pub fn contact_uy(mesh: &Mesh, dofs: &DofMap, sol: &[f64], x: f64, z: f64) -> Re
         if d < 0 { 0.0 } else { sol[d as usize] }
     });
     Ok(crate::fem::p2_tri_eval(&vals, bary))
+}
+
+/// The subsurface stresses of the dry scene (`output.subsurface`): the disc under the Hertz
+/// pressure and, with `effects.surface_traction = "friction"`, the traction q = mu p in +x.
+/// With equal Poisson ratios of the disc and the equivalent solid the factorisation of the
+/// main solve is reused (one more right-hand side); otherwise rank 0 solves the disc's own
+/// elastic problem. Collective; the JSON object is returned on rank 0.
+fn subsurface_stresses(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &mesh::Partition, dofs: &DofMap, ksp: &Ksp, main_solve_s: f64) -> Result<Option<serde_json::Value>, String> {
+    use super::subsurface as sub;
+    let pe = |e: petsc::PetscError| e.to_string();
+    let t0 = Instant::now();
+    let disc = scene.disc_material();
+    let mu = match scene.effects.surface_traction {
+        crate::case::SurfaceTraction::Friction => scene.operating.friction_coefficient,
+        crate::case::SurfaceTraction::Off => 0.0,
+    };
+    let load = |t: usize| {
+        let tri = mesh.contact_tris[t];
+        let v = [0, 1, 2].map(|i| {
+            let p = mesh.nodes[tri[i] as usize];
+            [p[0], p[2]]
+        });
+        hertz_load::hertz_p2_load(&v, HERTZ_SPLIT_DEPTH).map(|f| [mu * f, -f, 0.0])
+    };
+    let reuse = (disc.nu - scene.equivalent_solid().nu).abs() < 1e-12;
+    let (u, cost) = if reuse {
+        let rss0 = sub::current_rss_mb();
+        let comm = petsc::comm_world();
+        let b = sub::assemble_face_traction(comm, mesh, part, dofs, ctx.rank, &load).map_err(pe)?;
+        let x = Vector::new(comm, dofs.local(ctx.rank)).map_err(pe)?;
+        ksp.solve(&b, &x).map_err(pe)?;
+        let sol = x.gather_all().map_err(pe)?;
+        let cost = sub::SolveCost { seconds: t0.elapsed().as_secs_f64(), rss_increase_mb: sub::current_rss_mb() - rss0, factor_mb: ksp.mumps_factor_mb(), unknowns: dofs.total() };
+        (Some(sub::node_displacements(dofs, &sol, 1.0)), cost)
+    } else if ctx.rank == 0 {
+        let (mut u, c) = sub::solve_alone(mesh, disc.nu, &[&load])?;
+        (u.pop(), c)
+    } else {
+        (None, sub::SolveCost::default())
+    };
+    let Some(u) = u else { return Ok(None) };
+    if ctx.rank != 0 {
+        return Ok(None);
+    }
+    let hertz = scene.hertz();
+    let traction = if mu > 0.0 { format!("Hertz pressure and q = {mu} p in +x") } else { "Hertz pressure".to_string() };
+    let params = sub::Params {
+        nu: disc.nu,
+        e: disc.e,
+        a: hertz.a,
+        ph: hertz.ph,
+        rect: mesh::Rect { x0: scene.reynolds.x_min, x1: scene.reynolds.x_max, z0: scene.reynolds.z_min, z1: scene.reynolds.z_max },
+        half: false,
+        png: scene.output.png,
+        vtu: scene.output.vtu,
+        traction: &traction,
+        method: scene.output.subsurface_recovery,
+    };
+    let log = |m: String| ctx.log(m);
+    let mut obj = sub::recover_and_write(mesh, &u, &params, &ctx.out_dir, &log)?;
+    obj["friction_coefficient"] = json!(mu);
+    obj["solve"] = json!({
+        "kind": if reuse { "the main solve's factorisation, one more right-hand side" } else { "rank 0: the disc's own elastic problem (MUMPS Cholesky)" },
+        "seconds": cost.seconds, "rss_increase_mb": cost.rss_increase_mb, "mumps_factor_mb": cost.factor_mb, "unknowns": cost.unknowns,
+        "main_solve_s": main_solve_s,
+    });
+    obj["total_s"] = json!(t0.elapsed().as_secs_f64());
+    ctx.log(format!("subsurface: {:.2} s (solve {:.2} s, main solve {:.2} s)", t0.elapsed().as_secs_f64(), cost.seconds, main_solve_s));
+    Ok(Some(obj))
 }
 
 pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
@@ -102,6 +173,7 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
         "deflection: U(0) = {:.5} (half-space -1), U(0) - U(a) = {:.5} (half-space -0.5)",
         u_c, u_c - u_a
     ));
+    let subsurface = if scene.output.subsurface { Some(subsurface_stresses(ctx, scene, &mesh, &part, &dofs, &ksp, solve_s)?) } else { None };
     let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
     let peak_total = collective::sum_f64(&ctx.world, crate::output::peak_rss_mb());
     let total_s = ctx.start.elapsed().as_secs_f64();
@@ -135,7 +207,11 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
             peak_rss_mb_all_ranks: peak_total,
             scene: scene.clone(),
         };
-        ctx.write_summary(&to_json(&summary)?)?;
+        let mut summary = to_json(&summary)?;
+        if let Some(Some(s)) = subsurface {
+            summary["subsurface"] = s;
+        }
+        ctx.write_summary(&summary)?;
     }
     Ok(())
 }

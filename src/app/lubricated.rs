@@ -250,6 +250,7 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
     if scene.output.vtu {
         write_face_vtu(dir, &fields, a, ph, hs, friction.as_ref())?;
     }
+    let subsurface = if scene.output.subsurface { Some(subsurface_point(ctx, scene, setup, &fields, friction.as_ref(), sol, condensation_s, dir)?) } else { None };
     // The nodal pressure a later run can start from (--start-from).
     let face_p = dir.join(super::restart::FACE_PRESSURE);
     crate::output::write_atomic(&face_p, super::restart::face_pressure_csv(mesh, &|n| fields.p_node(n), a, ph).as_bytes()).map_err(|e| format!("cannot write {}: {e}", face_p.display()))?;
@@ -319,8 +320,83 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
         scene: scene.clone(),
         friction: friction.as_ref().map(|f| FrictionSummary { model: scene.effects.friction.as_str().to_string(), fx: f.fx, fz: f.fz, fx_n: f.fx_n, fz_n: f.fz_n, tau_max_pa: f.tau_max }),
     };
-    ctx.write_summary_to(dir, &to_json(&summary)?)?;
+    let mut summary = to_json(&summary)?;
+    if let Some(s) = subsurface {
+        summary["subsurface"] = s;
+        summary["timing"]["subsurface_s"] = summary["subsurface"]["total_s"].clone();
+    }
+    ctx.write_summary_to(dir, &summary)?;
     Ok(res)
+}
+
+/// The subsurface stresses of one converged point (rank 0, `output.subsurface`): the disc's
+/// own elastic problem (its Poisson ratio, a unit Young's modulus) under the converged face
+/// pressure and, with `effects.surface_traction = "friction"`, the friction pass's shear
+/// stresses on the disc; one MUMPS Cholesky on rank 0 (the condensed Newton keeps no 3D
+/// displacement). Returns the `subsurface` object of summary.json.
+#[allow(clippy::too_many_arguments)]
+fn subsurface_point(ctx: &Context, scene: &Scene, setup: &Setup, fields: &FieldsOnFace, friction: Option<&FrictionResult>, sol: &EhlSolution, condensation_s: Option<f64>, dir: &Path) -> Result<serde_json::Value, String> {
+    use super::subsurface as sub;
+    let t0 = Instant::now();
+    let mesh = &setup.mesh;
+    let hertz = scene.hertz();
+    let with_friction = scene.effects.surface_traction == crate::case::SurfaceTraction::Friction;
+    // The friction pass's nodal shear stresses (Pa) per contact triangle.
+    let mut tau: Vec<Option<[[f64; 2]; 6]>> = vec![None; mesh.contact_tris.len()];
+    if with_friction {
+        let f = friction.ok_or("effects.surface_traction = \"friction\" needs the friction pass (effects.friction)")?;
+        for (t, v) in &f.nodal {
+            tau[*t] = Some(*v);
+        }
+    }
+    let load_with = |t: usize, shear: bool| -> [[f64; 3]; 6] {
+        let tri = mesh.contact_tris[t];
+        let v = [0, 1, 2].map(|i| {
+            let c = mesh.nodes[tri[i] as usize];
+            [c[0], c[2]]
+        });
+        let m = crate::fem::p2tri::p2_tri_mass(crate::fem::p2tri::tri_area(&v));
+        let p = tri.map(|n| fields.p_node(n));
+        let q = if shear { tau[t].unwrap_or([[0.0; 2]; 6]) } else { [[0.0; 2]; 6] };
+        std::array::from_fn(|i| {
+            let w = |f: &dyn Fn(usize) -> f64| (0..6).map(|j| m[i][j] * f(j)).sum::<f64>();
+            [w(&|j| q[j][0] / hertz.ph), -w(&|j| p[j]), w(&|j| q[j][1] / hertz.ph)]
+        })
+    };
+    let disc = scene.disc_material();
+    let load = |t: usize| load_with(t, true);
+    let pressure_only = |t: usize| load_with(t, false);
+    // With the friction traction, the pressure-only field too (one more back substitution).
+    let loads: Vec<&sub::FaceLoad> = if with_friction { vec![&load, &pressure_only] } else { vec![&load] };
+    let (us, cost) = sub::solve_alone(mesh, disc.nu, &loads)?;
+    let u = &us[0];
+    let traction = if with_friction { format!("EHL pressure and the {} shear stresses on the disc", scene.effects.friction) } else { "EHL pressure".to_string() };
+    let params = sub::Params {
+        nu: disc.nu,
+        e: disc.e,
+        a: hertz.a,
+        ph: hertz.ph,
+        rect: crate::mesh::Rect { x0: scene.reynolds.x_min, x1: scene.reynolds.x_max, z0: scene.reynolds.z_min, z1: if setup.half { 0.0 } else { scene.reynolds.z_max } },
+        half: setup.half,
+        png: scene.output.png,
+        vtu: scene.output.vtu,
+        traction: &traction,
+        method: scene.output.subsurface_recovery,
+    };
+    let log = |m: String| ctx.log(m);
+    let mut obj = sub::recover_and_write(mesh, u, &params, dir, &log)?;
+    if with_friction {
+        let p2 = sub::Params { traction: "EHL pressure", ..params };
+        obj["pressure_only"] = sub::maxima_only(mesh, &us[1], &p2);
+    }
+    obj["solve"] = json!({
+        "kind": "rank 0: the disc's own elastic problem (MUMPS Cholesky)",
+        "seconds": cost.seconds, "rss_increase_mb": cost.rss_increase_mb, "mumps_factor_mb": cost.factor_mb, "unknowns": cost.unknowns,
+        "ehl_solve_s": sol.solve_s, "condensation_s": condensation_s,
+    });
+    obj["total_s"] = json!(t0.elapsed().as_secs_f64());
+    ctx.log(format!("subsurface: {:.2} s (elastic solve {:.2} s, MUMPS factor {:.0} MB; the EHL solve took {:.2} s)", t0.elapsed().as_secs_f64(), cost.seconds, cost.factor_mb.unwrap_or(f64::NAN), sol.solve_s));
+    Ok(obj)
 }
 
 fn write_profiles(dir: &Path, name: &str, rows: &[Vec<f64>], with_tau: bool) -> Result<(), String> {

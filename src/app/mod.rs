@@ -6,6 +6,7 @@ pub mod lubricated;
 pub mod plots;
 pub mod restart;
 pub mod study;
+pub mod subsurface;
 pub mod sweep;
 
 pub use crate::collective;

@@ -307,6 +307,26 @@ impl Scene {
                 .into());
             }
         }
+        if self.output.subsurface && e.elasticity == ElasticityModel::Rigid {
+            return Err(SceneErrorKind::Conflict(
+                "output.subsurface = true needs the elastic solid, but effects.elasticity = \"rigid\" has no 3D mesh (set effects.elasticity = \"elastic\" or output.subsurface = false)".into(),
+            )
+            .into());
+        }
+        if e.surface_traction == SurfaceTraction::Friction {
+            if e.lubrication == LubricationModel::Reynolds && e.friction == FrictionModel::Off {
+                return Err(SceneErrorKind::Conflict(
+                    "effects.surface_traction = \"friction\" applies the shear stresses of the friction pass, but effects.friction = \"none\" (set effects.friction or effects.surface_traction = \"none\")".into(),
+                )
+                .into());
+            }
+            if e.lubrication == LubricationModel::Dry && self.operating.friction_coefficient == 0.0 {
+                return Err(SceneErrorKind::Conflict(
+                    "effects.surface_traction = \"friction\" in a dry scene applies q = mu p with mu = operating.friction_coefficient, which is 0 (give operating.friction_coefficient > 0 or set effects.surface_traction = \"none\")".into(),
+                )
+                .into());
+            }
+        }
         for point in self.points() {
             point.validate_kinematics()?;
         }
@@ -348,6 +368,15 @@ impl Scene {
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();
         let e = &self.effects;
+        if self.mesh.core_depth > 0.0 && self.mesh.core_size == 0.0 {
+            w.push("mesh.core_depth is given but mesh.core_size = 0: there is no core to deepen".into());
+        }
+        if e.surface_traction == SurfaceTraction::Friction && !self.output.subsurface {
+            w.push("effects.surface_traction = \"friction\" only loads the subsurface stress field, which output.subsurface = false does not compute".into());
+        }
+        if self.operating.friction_coefficient > 0.0 && (e.lubrication == LubricationModel::Reynolds || e.surface_traction == SurfaceTraction::Off) {
+            w.push("operating.friction_coefficient is only used by a dry scene with effects.surface_traction = \"friction\" (a lubricated scene takes its traction from the friction pass)".into());
+        }
         if e.lubrication == LubricationModel::Dry {
             if e.friction != FrictionModel::Off {
                 w.push(format!("effects.friction = \"{}\" has no effect with effects.lubrication = \"none\" (no film, no shear pass)", e.friction));

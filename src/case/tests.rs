@@ -379,7 +379,7 @@ fn unknown_key_with_suggestion() {
     let e = err(&paper_with("png = false", "png = false\ncolour = true"));
     assert_eq!(
         e,
-        "unknown key 'output.colour' (known keys here: dir, vtu, png, shear_profile_z)"
+        "unknown key 'output.colour' (known keys here: dir, vtu, png, shear_profile_z, subsurface, subsurface_recovery)"
     );
 }
 
@@ -665,4 +665,29 @@ fn command_line_overrides_are_validated_like_the_file() {
     assert!(e.contains("--set operating.load") && e.contains("KEY=VALUE"), "{e}");
     let e = set(&["name.x=1"]).unwrap_err().to_string();
     assert!(e.contains("'name' is not a section"), "{e}");
+}
+
+#[test]
+fn subsurface_keys_are_checked_together() {
+    // The friction traction needs the friction pass.
+    let e = err(&paper_with("friction = \"ree-eyring\"", "friction = \"none\"\nsurface_traction = \"friction\""));
+    assert!(e.contains("effects.surface_traction") && e.contains("effects.friction"), "{e}");
+    // A dry scene's friction traction needs a coefficient.
+    let dry = include_str!("../../cases/dry-hertz.toml");
+    let e = err(&dry.replace("lubrication = \"none\"", "lubrication = \"none\"\nsurface_traction = \"friction\""));
+    assert!(e.contains("operating.friction_coefficient"), "{e}");
+    // Rigid solids have no 3D mesh.
+    let e = err(&paper_with("[output]", "[output]\nsubsurface = true").replace("elasticity = \"elastic\"", "elasticity = \"rigid\""));
+    assert!(e.contains("output.subsurface") && e.contains("rigid"), "{e}");
+    // The defaults: off, nothing asked.
+    let s = parse_scene(PAPER_SPIN, "t").unwrap();
+    assert!(!s.output.subsurface);
+    assert_eq!(s.effects.surface_traction, SurfaceTraction::Off);
+    assert_eq!(s.output.subsurface_recovery, StressRecovery::Spr);
+    assert_eq!(s.mesh.core_depth, 0.0);
+    // A friction traction that nothing computes is a warning.
+    let s = parse_scene(&paper_with("friction = \"ree-eyring\"", "friction = \"ree-eyring\"\nsurface_traction = \"friction\""), "t").unwrap();
+    assert!(s.warnings().iter().any(|w| w.contains("output.subsurface")), "{:?}", s.warnings());
+    let s = parse_scene(&paper_with("[output]", "[output]\nsubsurface = true").replace("growth = ", "core_depth = 1.0\ngrowth = "), "t").unwrap();
+    assert!(s.warnings().iter().any(|w| w.contains("mesh.core_depth")), "{:?}", s.warnings());
 }

@@ -88,9 +88,9 @@ fn refined_bisector(spec: &MeshSpec, h: f64) -> refine::Bisector {
     let boxes: Vec<BoxRefinement> = spec
         .core
         .iter()
-        .map(|&c| (c, None))
-        .chain(spec.patch.iter().map(|&p| (p, spec.patch_radii)))
-        .map(|((c, size), radii)| ([c.x0, 0.0, c.z0], [c.x1, 0.0, c.z1], dyadic(size), radii))
+        .map(|&c| (c, None, spec.core_depth))
+        .chain(spec.patch.iter().map(|&p| (p, spec.patch_radii, 0.0)))
+        .map(|((c, size), radii, depth)| ([c.x0, -depth, c.z0], [c.x1, 0.0, c.z1], dyadic(size), radii))
         .collect();
     let ring = spec.ring.map(|r| (r.inner, r.outer, dyadic(r.size)));
     b.refine_and_close(|v, t| {

@@ -67,6 +67,10 @@ pub struct MeshSpec {
     /// Optional finer core: a rectangle inside `contact` meshed with size `core.1`
     /// (rounded down to 16/2^k), grading away from it at the same growth.
     pub core: Option<(Rect, f64)>,
+    /// Depth of the core (units of a): with `core_depth > 0` the core is the box of the
+    /// rectangle times `-core_depth <= Y <= 0` (the stresses below the contact), otherwise
+    /// the rectangle on the face.
+    pub core_depth: f64,
     /// Optional finer ring: the annulus `inner <= sqrt(X^2 + Z^2) <= outer` meshed with
     /// size `size` (rounded down to 16/2^k), grading away from it at the same growth.
     /// It follows the Hertz circle, where the inlet build-up, the side lobes and the
@@ -111,6 +115,7 @@ impl MeshSpec {
             contact_size: 0.25,
             growth: 0.5,
             core: None,
+            core_depth: 0.0,
             ring: None,
             patch: None,
             patch_radii: None,

@@ -70,6 +70,23 @@ impl Ksp {
         }
         Ok(its as usize)
     }
+
+    /// Memory MUMPS used for the factorisation (MB, summed over the ranks: INFOG(22)),
+    /// after a solve; None when the preconditioner is not a MUMPS factorisation.
+    pub fn mumps_factor_mb(&self) -> Option<f64> {
+        let mut pc: ffi::PC = std::ptr::null_mut();
+        pcall!(ffi::KSPGetPC(self.raw, &mut pc)).ok()?;
+        let mut f: ffi::Mat = std::ptr::null_mut();
+        pcall!(ffi::PCFactorGetMatrix(pc, &mut f)).ok()?;
+        let mut mtype: ffi::MatSolverType = std::ptr::null();
+        pcall!(ffi::MatFactorGetSolverType(f, &mut mtype)).ok()?;
+        if mtype.is_null() || unsafe { CStr::from_ptr(mtype) }.to_bytes() != b"mumps" {
+            return None;
+        }
+        let mut v: ffi::PetscInt = 0;
+        pcall!(ffi::MatMumpsGetInfog(f, 22, &mut v)).ok()?;
+        Some(v as f64)
+    }
 }
 
 impl Drop for Ksp {

@@ -50,7 +50,7 @@ choice_enum! {
 choice_enum! {
     /// `effects.kinematics`: surface velocities.
     pub enum KinematicsModel {
-        /// Rolling, sliding and spinning (physics.md section 3).
+        /// Rolling, sliding and spinning (docs/model.md section 3).
         Spin = "spin",
         /// Uniform surface velocities U_BO, U_DO, no spin.
         Uniform = "uniform",
@@ -89,6 +89,29 @@ choice_enum! {
     } default = Auto
 }
 
+choice_enum! {
+    /// `effects.surface_traction`: the tangential traction on the contact face in the
+    /// subsurface stress field (`output.subsurface`); the normal problem never sees it.
+    pub enum SurfaceTraction {
+        /// Only the normal pressure loads the solid.
+        Off = "none",
+        /// Also the shear stresses of the friction pass on the disc (lubricated scene), or
+        /// q = mu p in +x (dry scene, mu = `operating.friction_coefficient`).
+        Friction = "friction",
+    } default = Off
+}
+
+choice_enum! {
+    /// `output.subsurface_recovery`: how the continuous stress field is recovered from the
+    /// element stresses.
+    pub enum StressRecovery {
+        /// Superconvergent patch recovery (a polynomial fitted around every vertex).
+        Spr = "spr",
+        /// Volume-weighted average of the element values at each node.
+        Average = "average",
+    } default = Spr
+}
+
 /// `[effects]`: which physics is simulated. Every key is optional; the defaults are the
 /// paper's model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -110,6 +133,8 @@ pub struct Effects {
     pub cavitation: CavitationModel,
     /// "auto" | "off"; default "auto".
     pub symmetry: SymmetryMode,
+    /// "none" | "friction"; default "none".
+    pub surface_traction: SurfaceTraction,
 }
 
 /// Keys of `[effects]`.
@@ -169,6 +194,13 @@ pub const EFFECTS_FIELDS: &[Field] = &[
         "",
         Kind::Choice(SymmetryMode::NAMES),
         Presence::Default("\"auto\"")
+    ),
+    f!(
+        "surface_traction",
+        "tangential traction of the subsurface stress field (output.subsurface)",
+        "",
+        Kind::Choice(SurfaceTraction::NAMES),
+        Presence::Default("\"none\"")
     ),
 ];
 

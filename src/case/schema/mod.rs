@@ -414,7 +414,7 @@ fn default_tilt_angle() -> f64 {
     90.0
 }
 
-/// `[operating]`: load and kinematics (physics.md section 3).
+/// `[operating]`: load and kinematics (docs/model.md section 3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Operating {
@@ -432,6 +432,10 @@ pub struct Operating {
     /// (0, 90]; default 90 (no ball spin). lambda = 0 is singular and rejected.
     #[serde(default = "default_tilt_angle")]
     pub tilt_angle: f64,
+    /// Coulomb friction coefficient mu of a dry scene's surface traction q = mu p (in +x,
+    /// on the disc) when `effects.surface_traction = "friction"`; default 0.
+    #[serde(default)]
+    pub friction_coefficient: f64,
 }
 
 /// Keys of `[operating]`.
@@ -444,6 +448,8 @@ pub const OPERATING_FIELDS: &[Field] = &[
     f!("tilt_angle", "tilt angle lambda of the ball's rotation axis", "degrees", Kind::Number(Range::LeftOpen(0.0, 90.0)),
         Presence::Default("90"),
         note = "lambda = 0 is singular: the ball spin omega_B = U_BO/(R_B sin lambda) would be infinite"),
+    f!("friction_coefficient", "dry scene: Coulomb coefficient mu of the surface traction q = mu p in +x (effects.surface_traction = \"friction\")", "", Kind::Number(Range::Closed(0.0, 1.0)),
+        Presence::Default("0")),
 ];
 
 // ---------------------------------------------------------------------------------------

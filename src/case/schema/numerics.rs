@@ -155,6 +155,9 @@ pub struct MeshSettings {
     pub core_size: f64,
     /// Half width of the core square (units of a), default 1.25.
     pub core_half_width: f64,
+    /// Depth of the core (units of a): > 0 refines the box of the core square down to
+    /// this depth (for the subsurface stresses); default 0 (the square on the face).
+    pub core_depth: f64,
     /// Element size in the ring ring_inner <= sqrt(X^2 + Z^2) <= ring_outer around the
     /// Hertz circle (units of a); 0 (default): no ring refinement.
     pub ring_size: f64,
@@ -185,6 +188,7 @@ impl Default for MeshSettings {
             growth: 0.5,
             core_size: 0.0,
             core_half_width: 1.25,
+            core_depth: 0.0,
             ring_size: 0.0,
             ring_inner: 0.75,
             ring_outer: 1.25,
@@ -244,6 +248,13 @@ pub const MESH_FIELDS: &[Field] = &[
         Presence::Default("1.25")
     ),
     f!(
+        "core_depth",
+        "depth of the core box below the face (0: the core square on the face only; > 0 refines the solid below the contact for output.subsurface)",
+        "a",
+        Kind::Number(Range::Closed(0.0, 8.0)),
+        Presence::Default("0")
+    ),
+    f!(
         "ring_size",
         "element size in the ring around the Hertz circle, ring_inner <= r <= ring_outer (rounded down to 16/2^k; 0: no ring)",
         "a",
@@ -301,6 +312,11 @@ pub struct OutputSettings {
     /// z (m) of the rolling-direction line along which the friction pass writes its
     /// shear-stress profile (`shear_profile.csv`); default 0 (the centre line).
     pub shear_profile_z: f64,
+    /// Recover the stresses inside the disc below the contact (subsurface.vtu, section
+    /// maps, `subsurface` in summary.json); default false.
+    pub subsurface: bool,
+    /// "spr" | "average"; default "spr".
+    pub subsurface_recovery: StressRecovery,
 }
 
 impl Default for OutputSettings {
@@ -311,6 +327,8 @@ impl Default for OutputSettings {
             vtu: true,
             png: true,
             shear_profile_z: 0.0,
+            subsurface: false,
+            subsurface_recovery: StressRecovery::Spr,
         }
     }
 }
@@ -344,5 +362,19 @@ pub const OUTPUT_FIELDS: &[Field] = &[
         "m",
         Kind::Number(Range::Any),
         Presence::Default("0")
+    ),
+    f!(
+        "subsurface",
+        "recover the stresses in the disc below the contact (one extra elastic solve)",
+        "",
+        Kind::Bool,
+        Presence::Default("false")
+    ),
+    f!(
+        "subsurface_recovery",
+        "stress recovery: superconvergent patch fit or nodal averaging",
+        "",
+        Kind::Choice(StressRecovery::NAMES),
+        Presence::Default("\"spr\"")
     ),
 ];

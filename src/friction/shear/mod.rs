@@ -1,4 +1,4 @@
-//! Per-point shear-stress law of an isothermal lubricant film (physics.md, friction pass).
+//! Per-point shear-stress law of an isothermal lubricant film (docs/model.md section 7).
 //!
 //! Across the film 0 <= y <= h (y measured from the disc surface D; y = h is the ball
 //! surface B) the momentum balance of the thin film gives stresses linear in y, with
