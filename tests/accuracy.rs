@@ -1,0 +1,58 @@
+//! Adaptive refinement to an accuracy target, end to end: the loop refines, starts each
+//! level from the last, reports its levels, and lands on the film of an independent code.
+mod common;
+use common::*;
+
+/// A lightly loaded Moes point (M = 10, L = 6, Barus, incompressible) on a coarse first mesh
+/// (0.5 a) with target 0.05: three levels or more, each with more unknowns, the estimates
+/// in summary.json below the target, and hc, hm within 5 % (the target) plus 1 % (what the
+/// models differ by: a clamped cube against a half-space, a cavitation penalty against the
+/// Reynolds condition) of the independent multigrid solution, hc 0.4595 um and
+/// hm 0.3126 um (Venner-Lubrecht full multigrid, 1025^2, extrapolated).
+#[test]
+fn a_moes_point_is_refined_to_its_target() {
+    let dir = scratch("accuracy_moes");
+    let scene = repo().join("cases/examples/moes-m10-l6.toml");
+    let out = mpirun(
+        2,
+        &[
+            scene.to_str().unwrap(),
+            "--output",
+            dir.join("run").to_str().unwrap(),
+            "--set",
+            "accuracy.target=0.05",
+            "--set",
+            "accuracy.max_levels=4",
+            "--set",
+            "mesh.contact_size=0.5",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("run/summary.json")).unwrap()).unwrap();
+    let acc = &s["accuracy"];
+    assert_eq!(acc["reached"], true, "{acc}");
+    let levels = acc["levels"].as_array().unwrap();
+    assert!(levels.len() >= 3, "{acc}");
+    for w in levels.windows(2) {
+        assert!(w[1]["pressure_unknowns"].as_u64() > w[0]["pressure_unknowns"].as_u64(), "{acc}");
+    }
+    for q in ["hc", "hm"] {
+        assert!(acc["estimated_error"][q].as_f64().unwrap() < 0.05, "{acc}");
+    }
+    let (hc, hm) = (s["film"]["hc_m"].as_f64().unwrap(), s["film"]["hm_m"].as_f64().unwrap());
+    assert!((hc / 0.4595e-6 - 1.0).abs() < 0.06, "hc {hc}");
+    assert!((hm / 0.3126e-6 - 1.0).abs() < 0.06, "hm {hm}");
+    let log = text(&out);
+    assert!(log.contains("accuracy: level 2"), "{log}");
+}
+
+/// A target where refinement cannot apply is refused before anything runs, naming the key.
+#[test]
+fn a_target_is_refused_where_it_cannot_apply() {
+    for (scene, why) in [("cases/dry-hertz.toml", "dry"), ("cases/examples/rigid-isoviscous.toml", "elastic"), ("cases/paper/fig7-8.toml", "sweep")] {
+        let out = run_plain(&["--check", repo().join(scene).to_str().unwrap(), "--set", "accuracy.target=0.01"]);
+        assert_eq!(out.status.code(), Some(2), "{scene}: {}", text(&out));
+        let t = text(&out);
+        assert!(t.contains("accuracy.target") && t.contains(why), "{scene}: {t}");
+    }
+}
