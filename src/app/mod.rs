@@ -1,5 +1,6 @@
 //! The program: reads the scene, starts PETSc, runs the simulation the scene asks for and
 //! writes the results. `main.rs` only parses the command line and calls [`run`].
+pub mod cli;
 pub mod collective;
 pub mod dry;
 pub mod lubricated;
@@ -116,7 +117,17 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     let petsc = match Petsc::init(&petsc_argv) {
         Ok(p) => p,
         Err(e) => {
-            eprintln!("ehl-petsc: error: cannot initialise PETSc: {e}");
+            // The other ranks may be waiting inside PetscInitialize (an options file read by
+            // rank 0 only): no collective agreement is possible, so this rank ends the job.
+            // Rank 0 prints at once; another rank waits a moment, so that when every rank
+            // failed the message comes once, from rank 0, before the abort.
+            if rank != 0 {
+                std::thread::sleep(std::time::Duration::from_secs(2));
+            }
+            let who = if rank == 0 { String::new() } else { format!(" (rank {rank})") };
+            eprintln!("ehl-petsc: error{who}: PETSc could not start with the given PETSc options or PETSC_OPTIONS (PETSc error code {}; PETSc's own message is above); all ranks are stopped", e.code);
+            // SAFETY: plain MPI_Abort on the world communicator; it does not return.
+            unsafe { mpi::ffi::MPI_Abort(mpi::ffi::RSMPI_COMM_WORLD, 3) };
             return 3;
         }
     };
@@ -144,8 +155,48 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             }
         }
     };
+    if rank == 0 {
+        // -options_left style: the user's PETSc options that nothing queried (misspelt, or
+        // for a solver this run did not use).
+        match crate::petsc::options::unused() {
+            Ok(left) => {
+                for (name, value) in left {
+                    let v = value.map(|v| format!(" {v}")).unwrap_or_default();
+                    eprintln!("ehl-petsc: warning: PETSc option '{name}{v}' was given but not used by this run (misspelt, or for a solver this run does not use)");
+                }
+            }
+            Err(e) => eprintln!("ehl-petsc: warning: cannot list unused PETSc options: {e}"),
+        }
+    }
     drop(petsc);
     code
+}
+
+/// `--check`: reads and checks everything [`run`] would check before solving (the scene
+/// with its overrides, its physical plausibility and mesh, the ladder, the earlier run),
+/// without MPI or PETSc; prints the outcome when `print` (the launcher's rank 0). Returns
+/// the exit code (0 valid, 2 not).
+pub fn check(opts: &RunOptions, print: bool) -> i32 {
+    match checked_inputs(opts) {
+        Ok((scene, _, _)) => {
+            if print {
+                for w in scene.warnings() {
+                    println!("ehl-petsc: warning: {w}");
+                }
+                if !opts.petsc_args.is_empty() {
+                    println!("ehl-petsc: warning: PETSc options are not used by --check: {}", opts.petsc_args.join(" "));
+                }
+                println!("ehl-petsc: scene '{}' is valid", opts.scene.display());
+            }
+            0
+        }
+        Err(e) => {
+            if print {
+                eprintln!("ehl-petsc: error: {e}");
+            }
+            2
+        }
+    }
 }
 
 /// What `run` checks before it touches the output folder: the scene (with its `--set`
