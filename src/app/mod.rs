@@ -73,10 +73,41 @@ impl Context {
     /// Writes summary.json into `dir` (atomically; see [`Context::write_summary`]).
     pub fn write_summary_to(&self, dir: &std::path::Path, summary: &serde_json::Value) -> Result<(), String> {
         let path = dir.join("summary.json");
+        // serde_json writes a NaN or an infinity as null: a result with such a number is
+        // never written, let alone marked converged.
+        let mut bad = Vec::new();
+        null_numbers(summary, "", &mut bad);
+        if !bad.is_empty() {
+            return Err(format!("the result holds numbers that are not finite ({}); no result written", bad.join(", ")));
+        }
         let text = serde_json::to_string_pretty(summary).map_err(|e| e.to_string())?;
         crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         self.log(format!("wrote {}", path.display()));
         Ok(())
+    }
+}
+
+/// Keys of summary.json that may be null (absent optional values), not non-finite numbers.
+const MAY_BE_NULL: &[&str] = &["spin_centre_z_m", "hc_hamrock_dowson_m", "hm_hamrock_dowson_m", "moes", "entrainment_speed_m_s", "snes_reason", "path"];
+
+/// The dotted paths of the nulls in `v` outside [`MAY_BE_NULL`] and the scene.
+fn null_numbers(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
+    match v {
+        serde_json::Value::Null => out.push(path.to_string()),
+        serde_json::Value::Object(m) => {
+            for (k, x) in m {
+                if path.is_empty() && k == "scene" || MAY_BE_NULL.contains(&k.as_str()) {
+                    continue;
+                }
+                null_numbers(x, &if path.is_empty() { k.clone() } else { format!("{path}.{k}") }, out);
+            }
+        }
+        serde_json::Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                null_numbers(x, &format!("{path}[{i}]"), out);
+            }
+        }
+        _ => {}
     }
 }
 
@@ -180,7 +211,7 @@ pub fn check(opts: &RunOptions, print: bool) -> i32 {
     match checked_inputs(opts) {
         Ok((scene, _, _)) => {
             if print {
-                for w in scene.warnings() {
+                for w in scene.warnings().into_iter().chain(scene.plausibility().unwrap_or_default()) {
                     println!("ehl-petsc: warning: {w}");
                 }
                 if !opts.petsc_args.is_empty() {
@@ -204,9 +235,17 @@ pub fn check(opts: &RunOptions, print: bool) -> i32 {
 /// of `--start-from`.
 fn checked_inputs(opts: &RunOptions) -> Result<(Scene, f64, Option<restart::EarlierRun>), String> {
     let scene = crate::case::load_scene_with(&opts.scene, &opts.overrides).map_err(|e| e.to_string())?;
+    let file = opts.scene.display();
+    scene.plausibility().map_err(|e| format!("{file}: {e}"))?;
+    check_mesh(&scene).map_err(|e| format!("{file}: {e}"))?;
     let first_size = opts.first_size.unwrap_or(opts.ladder.default_first());
     if let Some(n) = opts.study_levels {
         study::check_ladder(opts.ladder, first_size, n)?;
+        for k in 0..n {
+            let level = study::level_scene(&scene, opts.ladder, study::level_size(first_size, k));
+            check_mesh(&level).map_err(|e| format!("{file}: --convergence-study level {}: {e}", k + 1))?;
+            level.plausibility().map_err(|e| format!("{file}: --convergence-study level {}: {e}", k + 1))?;
+        }
     }
     if opts.study_sequence && opts.study_levels.is_none() {
         return Err("--sequence applies to --convergence-study N (a single solve takes --start-from DIR)".into());
@@ -221,9 +260,38 @@ fn checked_inputs(opts: &RunOptions) -> Result<(Scene, f64, Option<restart::Earl
     Ok((scene, first_size, earlier))
 }
 
+/// Checks that the mesher can build the scene's mesh (what it would refuse only after the
+/// solve has started), with messages naming the scene keys.
+pub fn check_mesh(scene: &Scene) -> Result<(), String> {
+    let half = scene.effects.lubrication == crate::case::LubricationModel::Reynolds && scene.uses_half_domain();
+    let spec = dry::mesh_spec(scene, half);
+    let h = crate::mesh::spec::dyadic_size(scene.mesh.contact_size);
+    let r = &scene.reynolds;
+    let mut edges = vec![("reynolds.x_min", r.x_min), ("reynolds.x_max", r.x_max), ("reynolds.z_min", r.z_min)];
+    if !half {
+        edges.push(("reynolds.z_max", r.z_max));
+    }
+    for (key, v) in edges {
+        let on_grid = |size: f64| ((v / size) - (v / size).round()).abs() < 1e-9;
+        if !on_grid(h) {
+            // The largest size 16/2^k the edge is a multiple of.
+            let fits = (0..=10).map(|k| 16.0 / f64::from(1u32 << k)).find(|&size| on_grid(size)).unwrap_or(crate::case::MIN_CONTACT_SIZE);
+            return Err(format!(
+                "{key} = {} is not a multiple of the contact element size {h} a (mesh.contact_size = {} rounded down to 16/2^k): the Reynolds rectangle's edges must lie on the contact grid (use mesh.contact_size <= {fits} or move the edge)",
+                crate::case::spec::fmt_num(v),
+                crate::case::spec::fmt_num(scene.mesh.contact_size),
+            ));
+        }
+    }
+    if scene.effects.elasticity == crate::case::ElasticityModel::Rigid && scene.effects.lubrication == crate::case::LubricationModel::Reynolds {
+        return Ok(());
+    }
+    spec.validate().map(|_| ()).map_err(|e| format!("the mesh of [mesh] and [reynolds] cannot be built ({}); check mesh.cube_size, mesh.contact_size and the reynolds.x_min/x_max/z_min/z_max rectangle", e.trim_start_matches("mesh spec: ")))
+}
+
 /// Dispatches on what the scene asks to simulate.
 fn simulate(ctx: &Context, scene: &Scene, earlier: Option<&restart::EarlierRun>) -> Result<(), String> {
-    for w in scene.warnings() {
+    for w in scene.warnings().into_iter().chain(scene.plausibility().unwrap_or_default()) {
         ctx.log(format!("warning: {w}"));
     }
     match scene.effects.lubrication {
