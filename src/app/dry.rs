@@ -67,6 +67,7 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let quality = mesh::quality(&mesh);
     let dofs = DofMap::new(&mesh, &part, ctx.size);
     let mesh_s = t0.elapsed().as_secs_f64();
+    crate::interrupt::check("the mesh")?;
     ctx.log(format!(
         "mesh: {} P2 tetrahedra, {} nodes, {} contact triangles, h_c = {} a, {} displacement unknowns, worst dihedral {:.1} deg",
         mesh.tets.len(), mesh.nodes.len(), mesh.contact_tris.len(), mesh.contact_size, dofs.total(), quality.min_dihedral_deg
@@ -77,6 +78,7 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let factor = assembly::traction_factor(eq.nu);
     let b = assembly::assemble_pressure_load(comm, &mesh, &part, &dofs, ctx.rank, factor, &|v| hertz_load::hertz_p2_load(v, HERTZ_SPLIT_DEPTH)).map_err(pe)?;
     let assembly_s = t1.elapsed().as_secs_f64();
+    crate::interrupt::check("the assembly")?;
     // Load check: the assembled traction sums to -factor * integral of P = -factor * 2 pi / 3.
     let load_num = {
         let local = b.local_values().map_err(pe)?;
@@ -92,6 +94,7 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let x = Vector::new(comm, dofs.local(ctx.rank)).map_err(pe)?;
     let its = ksp.solve(&b, &x).map_err(pe)?;
     let solve_s = t2.elapsed().as_secs_f64();
+    crate::interrupt::check("the elastic solve")?;
     ctx.log(format!("solve: {:.2} s ({} KSP iteration(s))", solve_s, its));
 
     let sol = x.gather_all().map_err(pe)?;
@@ -105,7 +108,10 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
     let peak_total = collective::sum_f64(&ctx.world, crate::output::peak_rss_mb());
     let total_s = ctx.start.elapsed().as_secs_f64();
-    if ctx.rank == 0 {
+    ctx.write_results(|dir| {
+        if ctx.rank != 0 {
+            return Ok(());
+        }
         let summary = json!({
             "case": scene.name,
             "ranks": ctx.size,
@@ -134,7 +140,6 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
             "peak_rss_mb_all_ranks": peak_total,
             "scene": scene,
         });
-        ctx.write_summary(&summary)?;
-    }
-    Ok(())
+        ctx.write_summary_to(dir, &summary)
+    })
 }

@@ -124,6 +124,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         ctx.log(format!("spin: the mean surface velocity turns about (0, {zc:.3}a){inside}"));
     }
     let setup = Setup::new(ctx, scene)?;
+    crate::interrupt::check("the mesh")?;
     let report = effects_report(scene, setup.half);
     ctx.log(format!("simulated: {}", report["simulated"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
     ctx.log(format!("skipped: {}", report["skipped"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
@@ -136,8 +137,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // Mesh sequencing: the earlier run's pressure, in this scene's scales.
         Some(e) => e.solve(ctx, scene, &solver)?,
     };
-    let r = post_point(ctx, scene, &setup, &sol, solver.condensation_s, &ctx.out_dir);
-    collective::agree(&ctx.world, r).map(|_| ())
+    crate::interrupt::check("the Newton solve")?;
+    // The friction pass and every output file go to a staging folder, moved into the
+    // output folder only when complete and not interrupted.
+    ctx.write_results(|dir| post_point(ctx, scene, &setup, &sol, solver.condensation_s, dir)).map(|_| ())
 }
 
 /// The friction setup of the scene, or None when `effects.friction = "none"`.

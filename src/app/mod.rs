@@ -64,6 +64,31 @@ impl Context {
         self.write_summary_to(&self.out_dir.clone(), summary)
     }
 
+    /// Writes the results of one solve through a staging folder: `write` fills the staging
+    /// folder (rank 0 writes, the other ranks take part in its collective steps), then every
+    /// rank checks for an interruption together, and only then rank 0 moves the files into
+    /// the output folder. A failure or a signal before that leaves no result file.
+    /// Collective.
+    pub fn write_results<T>(&self, write: impl FnOnce(&std::path::Path) -> Result<T, String>) -> Result<T, String> {
+        let staging = self.out_dir.join(format!(".partial-{}", std::process::id()));
+        self.create_dir(&staging)?;
+        let written = collective::agree(&self.world, write(&staging));
+        let result = written.and_then(|v| crate::interrupt::check("writing the results").map(|()| v));
+        let published = if self.rank == 0 {
+            match &result {
+                Ok(_) => crate::output::publish(&staging, &self.out_dir),
+                Err(_) => {
+                    let _ = std::fs::remove_dir_all(&staging);
+                    Ok(())
+                }
+            }
+        } else {
+            Ok(())
+        };
+        let published = collective::agree(&self.world, published);
+        result.and_then(|v| published.map(|()| v))
+    }
+
     /// Creates the output subfolder `dir` (rank 0; the outcome is shared). Collective.
     pub fn create_dir(&self, dir: &std::path::Path) -> Result<(), String> {
         let made = if self.rank == 0 { std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display())) } else { Ok(()) };
@@ -135,14 +160,6 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
         return 0;
     }
     let out_dir = opts.output.clone().unwrap_or_else(|| PathBuf::from(&scene.output.dir));
-    // The output folder is checked before any solve starts (by rank 0, outcome shared).
-    let ready = if rank == 0 { crate::output::prepare_output_dir(&out_dir) } else { Ok(()) };
-    if let Err(e) = collective::agree(&world, ready) {
-        if rank == 0 {
-            eprintln!("ehl-petsc: error: {e}");
-        }
-        return 2;
-    }
     let mut petsc_argv = vec!["ehl-petsc".to_string()];
     petsc_argv.extend(opts.petsc_args.iter().cloned());
     let petsc = match Petsc::init(&petsc_argv) {
@@ -163,6 +180,19 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
         }
     };
     crate::interrupt::install();
+    // The output folder is claimed before any solve starts (rank 0, outcome shared): created
+    // if needed, locked against another run using it.
+    let claim = if rank == 0 { crate::output::claim_output_dir(&out_dir).map(Some) } else { Ok(None) };
+    let claim = match collective::agree(&world, claim) {
+        Ok(c) => c,
+        Err(e) => {
+            if rank == 0 {
+                eprintln!("ehl-petsc: error: {e}");
+            }
+            drop(petsc);
+            return 2;
+        }
+    };
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {
@@ -186,6 +216,9 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             }
         }
     };
+    if let Some(c) = &claim {
+        c.release(code == 0);
+    }
     if rank == 0 {
         // -options_left style: the user's PETSc options that nothing queried (misspelt, or
         // for a solver this run did not use).
@@ -240,6 +273,12 @@ fn checked_inputs(opts: &RunOptions) -> Result<(Scene, f64, Option<restart::Earl
     check_mesh(&scene).map_err(|e| format!("{file}: {e}"))?;
     let first_size = opts.first_size.unwrap_or(opts.ladder.default_first());
     if let Some(n) = opts.study_levels {
+        if scene.effects.lubrication != crate::case::LubricationModel::Reynolds {
+            return Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into());
+        }
+        if scene.is_sweep() {
+            return Err("--convergence-study solves one operating point: remove [sweep] from the scene".into());
+        }
         study::check_ladder(opts.ladder, first_size, n)?;
         for k in 0..n {
             let level = study::level_scene(&scene, opts.ladder, study::level_size(first_size, k));
