@@ -80,7 +80,17 @@ fn usage_error(rank0: bool, msg: &str) -> ! {
     if rank0 {
         eprintln!("ehl-petsc: error: {msg} (see ehl-petsc --help)");
     }
-    std::process::exit(2);
+    exit_quietly(rank0, 2)
+}
+
+/// Ends a rank that runs without MPI (a usage error, --check). The other ranks wait a
+/// moment so that rank 0, which prints the outcome, ends first: a launcher that tears the
+/// job down at the first non-zero exit would otherwise cut its message.
+fn exit_quietly(rank0: bool, code: i32) -> ! {
+    if !rank0 && code != 0 {
+        std::thread::sleep(std::time::Duration::from_millis(300));
+    }
+    std::process::exit(code)
 }
 
 fn main() {
@@ -103,7 +113,7 @@ fn main() {
             if rank0 {
                 let _ = e.print();
             }
-            std::process::exit(code);
+            exit_quietly(rank0, code);
         }
     };
     if cli.scene_reference {
@@ -130,7 +140,7 @@ fn main() {
     };
     if opts.check_only {
         // Validation only: no MPI, no PETSc, nothing written.
-        std::process::exit(ehl_petsc::app::check(&opts, rank0));
+        exit_quietly(rank0, ehl_petsc::app::check(&opts, rank0));
     }
     let Some(universe) = mpi::initialize() else {
         if rank0 {

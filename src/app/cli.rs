@@ -50,6 +50,9 @@ pub fn split(args: &[String]) -> Result<Split, String> {
                 out.ours.push(w.to_string());
                 if !body.contains('=') {
                     let v = args.get(i + 1).ok_or_else(|| format!("option '{name}' needs a value"))?;
+                    if v.starts_with("--") {
+                        return Err(format!("option '{name}' needs a value (found the option '{v}'; write {name}=VALUE for a value that starts with two dashes)"));
+                    }
                     out.ours.push(v.clone());
                     i += 1;
                 }

@@ -73,7 +73,7 @@ impl Context {
         let staging = self.out_dir.join(format!(".partial-{}", std::process::id()));
         self.create_dir(&staging)?;
         let written = collective::agree(&self.world, write(&staging));
-        let result = written.and_then(|v| crate::interrupt::check("writing the results").map(|()| v));
+        let result = written.and_then(|v| crate::interrupt::check("the post-processing (friction pass, output files)").map(|()| v));
         let published = if self.rank == 0 {
             match &result {
                 Ok(_) => crate::output::publish(&staging, &self.out_dir),
