@@ -262,7 +262,7 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
         "mesh": {
             "elements": mesh.tets.len(), "nodes": mesh.nodes.len(), "dofs_total": layout.total(),
             "contact_triangles": mesh.contact_tris.len(), "contact_size_a": mesh.contact_size,
-            "worst_quality": setup.worst_quality, "worst_quality_measure": "minimum dihedral angle (degrees)",
+            "worst_quality": setup.worst_quality.is_finite().then_some(setup.worst_quality), "worst_quality_measure": "minimum dihedral angle (degrees)",
         },
         "film": {
             "hc_m": st.hc * hs, "hm_m": st.hm * hs, "hm_x_m": st.hm_at[0] * a, "hm_z_m": st.hm_at[1] * a, "h0_m": st.h0 * hs,

@@ -112,8 +112,9 @@ impl Context {
     }
 }
 
-/// Keys of summary.json that may be null (absent optional values), not non-finite numbers.
-const MAY_BE_NULL: &[&str] = &["spin_centre_z_m", "hc_hamrock_dowson_m", "hm_hamrock_dowson_m", "moes", "entrainment_speed_m_s", "snes_reason", "path"];
+/// Keys of summary.json that may be null (absent optional values, such as the mesh quality
+/// of rigid solids, which have no 3D mesh), not non-finite numbers.
+const MAY_BE_NULL: &[&str] = &["worst_quality", "spin_centre_z_m", "hc_hamrock_dowson_m", "hm_hamrock_dowson_m", "moes", "entrainment_speed_m_s", "snes_reason", "path"];
 
 /// The dotted paths of the nulls in `v` outside [`MAY_BE_NULL`] and the scene.
 fn null_numbers(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
