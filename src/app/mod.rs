@@ -86,6 +86,9 @@ impl Context {
             Ok(())
         };
         let published = collective::agree(&self.world, published);
+        if result.is_ok() && published.is_ok() {
+            self.log(format!("results moved into {}", self.out_dir.display()));
+        }
         result.and_then(|v| published.map(|()| v))
     }
 
