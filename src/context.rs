@@ -32,6 +32,34 @@ impl Context {
         self.write_summary_to(&self.out_dir.clone(), summary)
     }
 
+    /// Writes the results of one solve through a staging folder: `write` fills the staging
+    /// folder (rank 0 writes, the other ranks take part in its collective steps), then every
+    /// rank checks for an interruption together, and only then rank 0 moves the files into
+    /// the output folder. A failure or a signal before that leaves no result file.
+    /// Collective.
+    pub fn write_results<T>(&self, write: impl FnOnce(&std::path::Path) -> Result<T, String>) -> Result<T, String> {
+        let staging = self.out_dir.join(format!(".partial-{}", std::process::id()));
+        self.create_dir(&staging)?;
+        let written = collective::agree(&self.world, write(&staging));
+        let result = written.and_then(|v| crate::interrupt::check("the post-processing (friction pass, output files)").map(|()| v));
+        let published = if self.rank == 0 {
+            match &result {
+                Ok(_) => crate::output::publish(&staging, &self.out_dir),
+                Err(_) => {
+                    let _ = std::fs::remove_dir_all(&staging);
+                    Ok(())
+                }
+            }
+        } else {
+            Ok(())
+        };
+        let published = collective::agree(&self.world, published);
+        if result.is_ok() && published.is_ok() {
+            self.log(format!("results moved into {}", self.out_dir.display()));
+        }
+        result.and_then(|v| published.map(|()| v))
+    }
+
     /// Creates the output subfolder `dir` (rank 0; the outcome is shared). Collective.
     pub fn create_dir(&self, dir: &std::path::Path) -> Result<(), String> {
         let made = if self.rank == 0 { std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display())) } else { Ok(()) };
@@ -41,9 +69,41 @@ impl Context {
     /// Writes summary.json into `dir` (atomically; see [`Context::write_summary`]).
     pub fn write_summary_to(&self, dir: &std::path::Path, summary: &serde_json::Value) -> Result<(), String> {
         let path = dir.join("summary.json");
+        // serde_json writes a NaN or an infinity as null: a result with such a number is
+        // never written, let alone marked converged.
+        let mut bad = Vec::new();
+        null_numbers(summary, "", &mut bad);
+        if !bad.is_empty() {
+            return Err(format!("the result holds numbers that are not finite ({}); no result written", bad.join(", ")));
+        }
         let text = serde_json::to_string_pretty(summary).map_err(|e| e.to_string())?;
         crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         self.log(format!("wrote {}", path.display()));
         Ok(())
+    }
+}
+
+/// Keys of summary.json that may be null (absent optional values, such as the mesh quality
+/// of rigid solids, which have no 3D mesh), not non-finite numbers.
+const MAY_BE_NULL: &[&str] = &["worst_quality", "spin_centre_z_m", "hc_hamrock_dowson_m", "hm_hamrock_dowson_m", "moes", "entrainment_speed_m_s", "snes_reason", "path"];
+
+/// The dotted paths of the nulls in `v` outside [`MAY_BE_NULL`] and the scene.
+fn null_numbers(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
+    match v {
+        serde_json::Value::Null => out.push(path.to_string()),
+        serde_json::Value::Object(m) => {
+            for (k, x) in m {
+                if path.is_empty() && k == "scene" || MAY_BE_NULL.contains(&k.as_str()) {
+                    continue;
+                }
+                null_numbers(x, &if path.is_empty() { k.clone() } else { format!("{path}.{k}") }, out);
+            }
+        }
+        serde_json::Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                null_numbers(x, &format!("{path}[{i}]"), out);
+            }
+        }
+        _ => {}
     }
 }

@@ -1,14 +1,18 @@
 //! SIGINT and SIGTERM: a run stops on every rank at the next check, with a clear message,
 //! and writes no result of the interrupted solve.
 //!
-//! The signal handler only stores the signal number (async-signal-safe). The solve checks
-//! it at points every rank reaches together (each Newton residual evaluation, after the
-//! elastic condensation, before each sweep point and study level) through an MPI
+//! The signal handler only stores the signal number (async-signal-safe). The run checks
+//! it at points every rank reaches together (after the mesh; on the dry path after the
+//! assembly and the elastic solve; after the elastic condensation; at each Newton residual
+//! evaluation; after Newton; before each sweep point and study level; and after the
+//! friction pass and the output files, before they are moved into place) through an MPI
 //! reduction, so a signal that reaches one rank only (a batch system killing one task)
 //! stops all of them at the same point instead of leaving the others waiting in a
 //! collective call. Results are written only after a converged solve, each file through a
-//! temporary name and a rename ([`crate::output::write_atomic`]): an interrupted run leaves
-//! the files of earlier runs (or of the sweep points it completed) and nothing half-written.
+//! temporary name and a rename ([`crate::output::write_atomic`]), and a single solve's
+//! files through a staging folder ([`crate::app::Context::write_results`]): an interrupted
+//! run leaves the files of earlier runs (or of the sweep points it completed) and nothing
+//! of its own.
 //!
 //! Installed after `PetscInitialize`, so it replaces PETSc's own handler for these two
 //! signals (which would abort without cleaning up). Exit code 128 + signal number.

@@ -1,9 +1,13 @@
-//! Command line of ehl-petsc: `ehl-petsc [OPTIONS] SCENE.toml [PETSc options...]`.
+//! Command line of ehl-petsc: `ehl-petsc [OPTIONS] SCENE.toml [PETSc options...]`; our
+//! double-dash options may stand anywhere, PETSc's options take a single dash or follow
+//! `--` (see [`ehl_petsc::app::cli`]).
 use clap::{ArgAction, Parser};
 use std::path::PathBuf;
 
 const AFTER_HELP: &str = "\
-PETSc options follow the scene file and go to PETSc unchanged (PETSC_OPTIONS works too):
+Options of ehl-petsc take two dashes and may stand anywhere; an unknown one is an error.
+PETSc options take one dash (or follow '--') and go to PETSc unchanged (PETSC_OPTIONS works too);
+  options nobody used are listed as a warning at the end of the run:
   mpirun -n 2 ehl-petsc cases/dry-hertz.toml -ksp_view -log_view
   ehl-petsc cases/dry-hertz.toml -pc_type gamg -ksp_type cg -ksp_rtol 1e-10
 Defaults: -ksp_type preonly -pc_type lu; MUMPS (-mat_mumps_icntl_7 4, PORD) for sparse matrices;
@@ -12,21 +16,19 @@ Defaults: -ksp_type preonly -pc_type lu; MUMPS (-mat_mumps_icntl_7 4, PORD) for 
 Useful: -log_view, -ksp_view, -options_left (lists options nobody used), -mat_mumps_icntl_4 2.
 The solver's own options (-ehl_monitor, -ehl_check_jacobian, -ehl_supg_delta, ...) are listed
   with the others by -help after the scene.
-Exit codes: 0 success, 1 solve failed or did not converge, 2 bad scene or output folder, 3 PETSc start-up,
+Exit codes: 0 success, 1 solve failed or did not converge, 2 bad command line, scene or output folder
+  (also an output folder in use by another run), 3 MPI or PETSc start-up (all ranks end),
   130/143 interrupted by SIGINT/SIGTERM (all ranks stop at the next check; no result of the
   interrupted solve is written).";
 
 /// Full-system FEM solver for elastohydrodynamic lubrication (EHL) of circular contacts
 /// under rolling, sliding and spinning, on PETSc and MPI.
 #[derive(Parser, Debug)]
-#[command(name = "ehl-petsc", version, disable_help_flag = true, disable_version_flag = true, after_help = AFTER_HELP, trailing_var_arg = true)]
+#[command(name = "ehl-petsc", version, override_usage = "ehl-petsc [OPTIONS] SCENE.toml [PETSc options: -name [value] ... or after --]", disable_help_flag = true, disable_version_flag = true, after_help = AFTER_HELP)]
 struct Cli {
     /// Scene file (TOML): geometry, materials, lubricant, operating point, mesh, outputs
     #[arg(required_unless_present = "scene_reference")]
     scene: Option<PathBuf>,
-    /// PETSc options, e.g. -ksp_view -log_view -snes_monitor (single dash, after the scene)
-    #[arg(allow_hyphen_values = true, value_name = "PETSC_OPTIONS")]
-    petsc_args: Vec<String>,
     /// Output folder (default: the scene's output.dir)
     #[arg(long, value_name = "DIR")]
     output: Option<PathBuf>,
@@ -75,14 +77,77 @@ struct Cli {
     version: Option<bool>,
 }
 
+/// A usage error: printed once (by the launcher's rank 0), exit 2.
+fn usage_error(rank0: bool, msg: &str) -> ! {
+    if rank0 {
+        eprintln!("ehl-petsc: error: {msg} (see ehl-petsc --help)");
+    }
+    exit_quietly(rank0, 2)
+}
+
+/// Ends a rank that runs without MPI (a usage error, --check). The other ranks wait a
+/// moment so that rank 0, which prints the outcome, ends first: a launcher that tears the
+/// job down at the first non-zero exit would otherwise cut its message.
+fn exit_quietly(rank0: bool, code: i32) -> ! {
+    if !rank0 && code != 0 {
+        std::thread::sleep(std::time::Duration::from_millis(300));
+    }
+    std::process::exit(code)
+}
+
 fn main() {
-    let cli = Cli::parse();
+    use ehl_petsc::app::cli;
+    // The command line is checked before MPI starts: a usage error ends every rank the same
+    // way, printed once.
+    let rank0 = cli::launcher_rank() == 0;
+    let args: Vec<String> = std::env::args_os()
+        .skip(1)
+        .map(|a| a.into_string().unwrap_or_else(|a| usage_error(rank0, &format!("argument {a:?} is not valid UTF-8"))))
+        .collect();
+    let split = cli::split(&args).unwrap_or_else(|e| usage_error(rank0, &e));
+    let cli = match Cli::try_parse_from(std::iter::once("ehl-petsc".to_string()).chain(split.ours)) {
+        Ok(c) => c,
+        Err(e) => {
+            let code = match e.kind() {
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => 0,
+                _ => 2,
+            };
+            if rank0 {
+                let _ = e.print();
+            }
+            exit_quietly(rank0, code);
+        }
+    };
     if cli.scene_reference {
-        print!("{}", ehl_petsc::case::reference_markdown());
+        if rank0 {
+            print!("{}", ehl_petsc::case::reference_markdown());
+        }
         return;
     }
+    if let Err(e) = cli::check_petsc_args(&split.petsc) {
+        usage_error(rank0, &e);
+    }
+    let opts = ehl_petsc::app::RunOptions {
+        scene: cli.scene.unwrap_or_else(|| usage_error(rank0, "no scene file given")),
+        output: cli.output,
+        petsc_args: split.petsc,
+        check_only: cli.check,
+        quiet: cli.quiet,
+        study_levels: cli.convergence_study,
+        ladder: cli.ladder,
+        first_size: cli.first_size,
+        overrides: cli.set,
+        start_from: cli.start_from,
+        study_sequence: cli.sequence,
+    };
+    if opts.check_only {
+        // Validation only: no MPI, no PETSc, nothing written.
+        exit_quietly(rank0, ehl_petsc::app::check(&opts, rank0));
+    }
     let Some(universe) = mpi::initialize() else {
-        eprintln!("ehl-petsc: error: MPI could not be initialised");
+        if rank0 {
+            eprintln!("ehl-petsc: error: MPI could not be initialised");
+        }
         std::process::exit(3);
     };
     let world = universe.world();
@@ -93,19 +158,6 @@ fn main() {
         eprintln!("ehl-petsc: internal error, aborting all MPI ranks");
         unsafe { mpi::ffi::MPI_Abort(mpi::ffi::RSMPI_COMM_WORLD, 70) };
     }));
-    let opts = ehl_petsc::app::RunOptions {
-        scene: cli.scene.expect("clap requires the scene"),
-        output: cli.output,
-        petsc_args: cli.petsc_args,
-        check_only: cli.check,
-        quiet: cli.quiet,
-        study_levels: cli.convergence_study,
-        ladder: cli.ladder,
-        first_size: cli.first_size,
-        overrides: cli.set,
-        start_from: cli.start_from,
-        study_sequence: cli.sequence,
-    };
     let code = ehl_petsc::app::run(world, opts);
     drop(universe);
     std::process::exit(code);

@@ -75,7 +75,7 @@ fn assert_no_results(out: &Path) {
 fn sigterm_on_one_rank_during_condensation_stops_both_ranks_cleanly() {
     // The signal reaches rank 1 only (a batch system killing one task): rank 0 must not
     // hang in a collective call; both stop at the next collective check.
-    let (code, stderr, out) = interrupt_run("fault-sigterm-one-rank", "symmetry:", libc::SIGTERM, Target::OneRank);
+    let (code, stderr, out) = interrupt_run("fault-sigterm-one-rank", "coupling: condensed", libc::SIGTERM, Target::OneRank);
     assert_ne!(code, Some(0), "{stderr}");
     assert!(stderr.contains("interrupted by SIGTERM during the elastic condensation"), "{stderr}");
     assert_eq!(stderr.matches("ehl-petsc: error").count(), 1, "one message, printed once: {stderr}");

@@ -14,7 +14,7 @@
 //!    every estimate is below the target (from level 2 on, so that rho is measured), or
 //!    fail honestly after `accuracy.max_levels`.
 use super::lubricated::{post_point, Setup};
-use super::{collective, Context};
+use super::Context;
 use crate::case::Scene;
 use crate::ehl::driver::{self, EhlSolution, EhlSolver, Start};
 use crate::ehl::post::FieldsOnFace;
@@ -225,12 +225,14 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 ));
             }
             ctx.log(format!("accuracy: target {target} reached at level {k}"));
-            let r = post_point(ctx, scene, &setup, &sol, solver.condensation_s, &ctx.out_dir);
-            collective::agree(&ctx.world, r)?;
-            if ctx.rank == 0 {
-                add_accuracy_to_summary(ctx, target, &levels)?;
-            }
-            return Ok(());
+            crate::interrupt::check("the Newton solve")?;
+            return ctx.write_results(|dir| {
+                post_point(ctx, scene, &setup, &sol, solver.condensation_s, dir)?;
+                if ctx.rank == 0 {
+                    add_accuracy_to_summary(ctx, dir, target, &levels)?;
+                }
+                Ok(())
+            });
         }
         let eta = indicators(scene, &fields);
         let eligible: Vec<bool> = (0..eta.len()).map(|t| longest_edge(&fields, t) > 1.5 * MIN_ADAPTIVE_SIZE).collect();
@@ -257,8 +259,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
 }
 
 /// Adds `accuracy` (target, estimates, levels) to the summary.json that post_point wrote.
-fn add_accuracy_to_summary(ctx: &Context, target: f64, levels: &[Level]) -> Result<(), String> {
-    let path = ctx.out_dir.join("summary.json");
+fn add_accuracy_to_summary(ctx: &Context, dir: &std::path::Path, target: f64, levels: &[Level]) -> Result<(), String> {
+    let path = dir.join("summary.json");
     let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let mut summary: serde_json::Value = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
     let last = levels.last().expect("a level");
@@ -276,7 +278,7 @@ fn add_accuracy_to_summary(ctx: &Context, target: f64, levels: &[Level]) -> Resu
             "estimated_error": l.est.map(|e| json!({ "hc": e[0], "hm": e[1] })),
         })).collect::<Vec<_>>(),
     });
-    ctx.write_summary_to(&ctx.out_dir, &summary)
+    ctx.write_summary_to(dir, &summary)
 }
 
 #[cfg(test)]

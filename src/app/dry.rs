@@ -61,7 +61,8 @@ pub fn contact_uy(mesh: &Mesh, dofs: &DofMap, sol: &[f64], x: f64, z: f64) -> Re
 /// With equal Poisson ratios of the disc and the equivalent solid the factorisation of the
 /// main solve is reused (one more right-hand side); otherwise rank 0 solves the disc's own
 /// elastic problem. Collective; the JSON object is returned on rank 0.
-fn subsurface_stresses(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &mesh::Partition, dofs: &DofMap, ksp: &Ksp, main_solve_s: f64) -> Result<Option<serde_json::Value>, String> {
+#[allow(clippy::too_many_arguments)]
+fn subsurface_stresses(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &mesh::Partition, dofs: &DofMap, ksp: &Ksp, main_solve_s: f64, dir: &std::path::Path) -> Result<Option<serde_json::Value>, String> {
     use super::subsurface as sub;
     let pe = |e: petsc::PetscError| e.to_string();
     let t0 = Instant::now();
@@ -113,7 +114,7 @@ fn subsurface_stresses(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &mesh::P
         method: scene.output.subsurface_recovery,
     };
     let log = |m: String| ctx.log(m);
-    let mut obj = sub::recover_and_write(mesh, &u, &params, &ctx.out_dir, &log)?;
+    let mut obj = sub::recover_and_write(mesh, &u, &params, dir, &log)?;
     obj["friction_coefficient"] = json!(mu);
     obj["solve"] = json!({
         "kind": if reuse { "the main solve's factorisation, one more right-hand side" } else { "rank 0: the disc's own elastic problem (MUMPS Cholesky)" },
@@ -138,6 +139,7 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let quality = mesh::quality(&mesh);
     let dofs = DofMap::new(&mesh, &part, ctx.size);
     let mesh_s = t0.elapsed().as_secs_f64();
+    crate::interrupt::check("the mesh")?;
     ctx.log(format!(
         "mesh: {} P2 tetrahedra, {} nodes, {} contact triangles, h_c = {} a, {} displacement unknowns, worst dihedral {:.1} deg",
         mesh.tets.len(), mesh.nodes.len(), mesh.contact_tris.len(), mesh.contact_size, dofs.total(), quality.min_dihedral_deg
@@ -148,6 +150,7 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let factor = assembly::traction_factor(eq.nu);
     let b = assembly::assemble_pressure_load(comm, &mesh, &part, &dofs, ctx.rank, factor, &|v| hertz_load::hertz_p2_load(v, HERTZ_SPLIT_DEPTH)).map_err(pe)?;
     let assembly_s = t1.elapsed().as_secs_f64();
+    crate::interrupt::check("the assembly")?;
     // Load check: the assembled traction sums to -factor * integral of P = -factor * 2 pi / 3.
     let load_num = {
         let local = b.local_values().map_err(pe)?;
@@ -163,6 +166,7 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let x = Vector::new(comm, dofs.local(ctx.rank)).map_err(pe)?;
     let its = ksp.solve(&b, &x).map_err(pe)?;
     let solve_s = t2.elapsed().as_secs_f64();
+    crate::interrupt::check("the elastic solve")?;
     ctx.log(format!("solve: {:.2} s ({} KSP iteration(s))", solve_s, its));
 
     let sol = x.gather_all().map_err(pe)?;
@@ -173,11 +177,14 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
         "deflection: U(0) = {:.5} (half-space -1), U(0) - U(a) = {:.5} (half-space -0.5)",
         u_c, u_c - u_a
     ));
-    let subsurface = if scene.output.subsurface { Some(subsurface_stresses(ctx, scene, &mesh, &part, &dofs, &ksp, solve_s)?) } else { None };
     let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
     let peak_total = collective::sum_f64(&ctx.world, crate::output::peak_rss_mb());
     let total_s = ctx.start.elapsed().as_secs_f64();
-    if ctx.rank == 0 {
+    ctx.write_results(|dir| {
+        let subsurface = if scene.output.subsurface { Some(subsurface_stresses(ctx, scene, &mesh, &part, &dofs, &ksp, solve_s, dir)?) } else { None };
+        if ctx.rank != 0 {
+            return Ok(());
+        }
         use crate::output::summary::*;
         let summary = DrySummary {
             case: scene.name.clone(),
@@ -191,7 +198,7 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
                 dofs_total: dofs.total(),
                 contact_triangles: mesh.contact_tris.len(),
                 contact_size_a: mesh.contact_size,
-                worst_quality: quality.min_dihedral_deg,
+                worst_quality: Some(quality.min_dihedral_deg),
                 worst_quality_measure: "minimum dihedral angle (degrees)".into(),
                 max_aspect_ratio: Some(quality.max_aspect_ratio),
             },
@@ -211,7 +218,6 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
         if let Some(Some(s)) = subsurface {
             summary["subsurface"] = s;
         }
-        ctx.write_summary(&summary)?;
-    }
-    Ok(())
+        ctx.write_summary_to(dir, &summary)
+    })
 }

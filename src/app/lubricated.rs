@@ -135,6 +135,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         return super::adapt::run(ctx, scene, earlier);
     }
     let setup = Setup::new(ctx, scene)?;
+    crate::interrupt::check("the mesh")?;
     let report = effects_report(scene, setup.half);
     ctx.log(format!("simulated: {}", report["simulated"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
     ctx.log(format!("skipped: {}", report["skipped"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
@@ -147,8 +148,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // Mesh sequencing: the earlier run's pressure, in this scene's scales.
         Some(e) => e.solve(ctx, scene, &solver)?,
     };
-    let r = post_point(ctx, scene, &setup, &sol, solver.condensation_s, &ctx.out_dir);
-    collective::agree(&ctx.world, r).map(|_| ())
+    crate::interrupt::check("the Newton solve")?;
+    // The friction pass and every output file go to a staging folder, moved into the
+    // output folder only when complete and not interrupted.
+    ctx.write_results(|dir| post_point(ctx, scene, &setup, &sol, solver.condensation_s, dir)).map(|_| ())
 }
 
 /// The friction setup of the scene, or None when `effects.friction = "none"`.
@@ -278,7 +281,7 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
             dofs_total: layout.total(),
             contact_triangles: mesh.contact_tris.len(),
             contact_size_a: mesh.contact_size,
-            worst_quality: setup.worst_quality,
+            worst_quality: setup.worst_quality.is_finite().then_some(setup.worst_quality),
             worst_quality_measure: "minimum dihedral angle (degrees)".into(),
             max_aspect_ratio: None,
         },

@@ -1,6 +1,7 @@
 //! The program: reads the scene, starts PETSc, runs the simulation the scene asks for and
 //! writes the results. `main.rs` only parses the command line and calls [`run`].
 pub mod adapt;
+pub mod cli;
 pub mod dry;
 pub mod lubricated;
 pub mod plots;
@@ -64,20 +65,22 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
         return 0;
     }
     let out_dir = opts.output.clone().unwrap_or_else(|| PathBuf::from(&scene.output.dir));
-    // The output folder is checked before any solve starts (by rank 0, outcome shared).
-    let ready = if rank == 0 { crate::output::prepare_output_dir(&out_dir) } else { Ok(()) };
-    if let Err(e) = collective::agree(&world, ready) {
-        if rank == 0 {
-            eprintln!("ehl-petsc: error: {e}");
-        }
-        return 2;
-    }
     let mut petsc_argv = vec!["ehl-petsc".to_string()];
     petsc_argv.extend(opts.petsc_args.iter().cloned());
     let petsc = match Petsc::init(&petsc_argv) {
         Ok(p) => p,
         Err(e) => {
-            eprintln!("ehl-petsc: error: cannot initialise PETSc: {e}");
+            // The other ranks may be waiting inside PetscInitialize (an options file read by
+            // rank 0 only): no collective agreement is possible, so this rank ends the job.
+            // Rank 0 prints at once; another rank waits a moment, so that when every rank
+            // failed the message comes once, from rank 0, before the abort.
+            if rank != 0 {
+                std::thread::sleep(std::time::Duration::from_secs(2));
+            }
+            let who = if rank == 0 { String::new() } else { format!(" (rank {rank})") };
+            eprintln!("ehl-petsc: error{who}: PETSc could not start with the given PETSc options or PETSC_OPTIONS (PETSc error code {}; PETSc's own message is above); all ranks are stopped", e.code);
+            // SAFETY: plain MPI_Abort on the world communicator; it does not return.
+            unsafe { mpi::ffi::MPI_Abort(mpi::ffi::RSMPI_COMM_WORLD, 3) };
             return 3;
         }
     };
@@ -93,6 +96,19 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             return 3;
         }
     }
+    // The output folder is claimed before any solve starts (rank 0, outcome shared): created
+    // if needed, locked against another run using it.
+    let claim = if rank == 0 { crate::output::claim_output_dir(&out_dir).map(Some) } else { Ok(None) };
+    let claim = match collective::agree(&world, claim) {
+        Ok(c) => c,
+        Err(e) => {
+            if rank == 0 {
+                eprintln!("ehl-petsc: error: {e}");
+            }
+            drop(petsc);
+            return 2;
+        }
+    };
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {
@@ -116,8 +132,51 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             }
         }
     };
+    if let Some(c) = &claim {
+        c.release(code == 0);
+    }
+    if rank == 0 {
+        // -options_left style: the user's PETSc options that nothing queried (misspelt, or
+        // for a solver this run did not use).
+        match crate::petsc::options::unused() {
+            Ok(left) => {
+                for (name, value) in left {
+                    let v = value.map(|v| format!(" {v}")).unwrap_or_default();
+                    eprintln!("ehl-petsc: warning: PETSc option '{name}{v}' was given but not used by this run (misspelt, or for a solver this run does not use)");
+                }
+            }
+            Err(e) => eprintln!("ehl-petsc: warning: cannot list unused PETSc options: {e}"),
+        }
+    }
     drop(petsc);
     code
+}
+
+/// `--check`: reads and checks everything [`run`] would check before solving (the scene
+/// with its overrides, its physical plausibility and mesh, the ladder, the earlier run),
+/// without MPI or PETSc; prints the outcome when `print` (the launcher's rank 0). Returns
+/// the exit code (0 valid, 2 not).
+pub fn check(opts: &RunOptions, print: bool) -> i32 {
+    match checked_inputs(opts) {
+        Ok((scene, _, _)) => {
+            if print {
+                for w in scene.warnings().into_iter().chain(scene.plausibility().unwrap_or_default()) {
+                    println!("ehl-petsc: warning: {w}");
+                }
+                if !opts.petsc_args.is_empty() {
+                    println!("ehl-petsc: warning: PETSc options are not used by --check: {}", opts.petsc_args.join(" "));
+                }
+                println!("ehl-petsc: scene '{}' is valid", opts.scene.display());
+            }
+            0
+        }
+        Err(e) => {
+            if print {
+                eprintln!("ehl-petsc: error: {e}");
+            }
+            2
+        }
+    }
 }
 
 /// What `run` checks before it touches the output folder: the scene (with its `--set`
@@ -125,9 +184,23 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
 /// of `--start-from`.
 fn checked_inputs(opts: &RunOptions) -> Result<(Scene, f64, Option<restart::EarlierRun>), String> {
     let scene = crate::case::load_scene_with(&opts.scene, &opts.overrides).map_err(|e| e.to_string())?;
+    let file = opts.scene.display();
+    scene.plausibility().map_err(|e| format!("{file}: {e}"))?;
+    check_mesh(&scene).map_err(|e| format!("{file}: {e}"))?;
     let first_size = opts.first_size.unwrap_or(opts.ladder.default_first());
     if let Some(n) = opts.study_levels {
+        if scene.effects.lubrication != crate::case::LubricationModel::Reynolds {
+            return Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into());
+        }
+        if scene.is_sweep() {
+            return Err("--convergence-study solves one operating point: remove [sweep] from the scene".into());
+        }
         study::check_ladder(opts.ladder, first_size, n)?;
+        for k in 0..n {
+            let level = study::level_scene(&scene, opts.ladder, study::level_size(first_size, k));
+            check_mesh(&level).map_err(|e| format!("{file}: --convergence-study level {}: {e}", k + 1))?;
+            level.plausibility().map_err(|e| format!("{file}: --convergence-study level {}: {e}", k + 1))?;
+        }
     }
     if opts.study_sequence && opts.study_levels.is_none() {
         return Err("--sequence applies to --convergence-study N (a single solve takes --start-from DIR)".into());
@@ -142,9 +215,38 @@ fn checked_inputs(opts: &RunOptions) -> Result<(Scene, f64, Option<restart::Earl
     Ok((scene, first_size, earlier))
 }
 
+/// Checks that the mesher can build the scene's mesh (what it would refuse only after the
+/// solve has started), with messages naming the scene keys.
+pub fn check_mesh(scene: &Scene) -> Result<(), String> {
+    let half = scene.effects.lubrication == crate::case::LubricationModel::Reynolds && scene.uses_half_domain();
+    let spec = dry::mesh_spec(scene, half);
+    let h = crate::mesh::spec::dyadic_size(scene.mesh.contact_size);
+    let r = &scene.reynolds;
+    let mut edges = vec![("reynolds.x_min", r.x_min), ("reynolds.x_max", r.x_max), ("reynolds.z_min", r.z_min)];
+    if !half {
+        edges.push(("reynolds.z_max", r.z_max));
+    }
+    for (key, v) in edges {
+        let on_grid = |size: f64| ((v / size) - (v / size).round()).abs() < 1e-9;
+        if !on_grid(h) {
+            // The largest size 16/2^k the edge is a multiple of.
+            let fits = (0..=10).map(|k| 16.0 / f64::from(1u32 << k)).find(|&size| on_grid(size)).unwrap_or(crate::case::MIN_CONTACT_SIZE);
+            return Err(format!(
+                "{key} = {} is not a multiple of the contact element size {h} a (mesh.contact_size = {} rounded down to 16/2^k): the Reynolds rectangle's edges must lie on the contact grid (use mesh.contact_size <= {fits} or move the edge)",
+                crate::case::spec::fmt_num(v),
+                crate::case::spec::fmt_num(scene.mesh.contact_size),
+            ));
+        }
+    }
+    if scene.effects.elasticity == crate::case::ElasticityModel::Rigid && scene.effects.lubrication == crate::case::LubricationModel::Reynolds {
+        return Ok(());
+    }
+    spec.validate().map(|_| ()).map_err(|e| format!("the mesh of [mesh] and [reynolds] cannot be built ({}); check mesh.cube_size, mesh.contact_size and the reynolds.x_min/x_max/z_min/z_max rectangle", e.trim_start_matches("mesh spec: ")))
+}
+
 /// Dispatches on what the scene asks to simulate.
 fn simulate(ctx: &Context, scene: &Scene, earlier: Option<&restart::EarlierRun>) -> Result<(), String> {
-    for w in scene.warnings() {
+    for w in scene.warnings().into_iter().chain(scene.plausibility().unwrap_or_default()) {
         ctx.log(format!("warning: {w}"));
     }
     match scene.effects.lubrication {

@@ -44,13 +44,21 @@ impl EarlierRun {
     pub fn read(dir: &Path) -> Result<EarlierRun, String> {
         let err = |what: String| format!("--start-from {}: {what}", dir.display());
         let summary_path = dir.join("summary.json");
-        let text = std::fs::read_to_string(&summary_path).map_err(|e| err(format!("cannot read {}: {e} (the folder of a converged lubricated run is expected)", summary_path.display())))?;
+        let text = crate::case::read_bounded(&summary_path, 16 << 20).map_err(|e| err(format!("cannot read {}: {e} (the folder of a converged lubricated run is expected)", summary_path.display())))?;
         let summary = match Summary::from_json(&text) {
             Ok(s) => s,
             Err(_) if serde_json::from_str::<DrySummary>(&text).is_ok() => return Err(err("the earlier run is a dry (Hertz) run: it has no film to start from".into())),
             Err(e) => return Err(err(format!("{} is not the summary of a lubricated run this version can read: {e}", summary_path.display()))),
         };
+        if !summary.converged {
+            return Err(err(format!("{} is not the summary of a converged run (\"converged\" is not true)", summary_path.display())));
+        }
         let (scene, hc_m, half) = (summary.scene, summary.film.hc_m, summary.solver.half_domain);
+        // The stored scene is checked as a scene file would be: it may have been edited.
+        let bad_scene = |e: String| err(format!("the scene stored in {} is not valid: {e}", summary_path.display()));
+        scene.validate().map_err(|e| bad_scene(e.to_string()))?;
+        scene.plausibility().map_err(|e| bad_scene(e.to_string()))?;
+        super::check_mesh(&scene).map_err(bad_scene)?;
         if !hc_m.is_finite() {
             return Err(err(format!("{} has no finite film.hc_m", summary_path.display())));
         }
@@ -60,7 +68,7 @@ impl EarlierRun {
             super::dry::build_mesh(&scene, half)?
         };
         let csv_path = dir.join(FACE_PRESSURE);
-        let csv = std::fs::read_to_string(&csv_path).map_err(|e| err(format!("cannot read {}: {e}", csv_path.display())))?;
+        let csv = crate::case::read_bounded(&csv_path, 256 << 20).map_err(|e| err(format!("cannot read {}: {e}", csv_path.display())))?;
         let a = scene.hertz().a;
         let rows: Vec<&str> = csv.lines().skip(1).filter(|l| !l.trim().is_empty()).collect();
         if rows.len() != mesh.contact_nodes.len() {

@@ -16,6 +16,7 @@
 //! [`reference_markdown`] renders the schema (keys, meaning, unit, range, default) as
 //! Markdown: docs/scene-reference.md is its output (a test keeps the two equal).
 pub mod error;
+pub mod plausible;
 pub mod schema;
 pub mod spec;
 
@@ -43,9 +44,49 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 /// value that is not valid TOML is taken as a string) applied before validation, so an
 /// override is checked like the file's own keys.
 pub fn load_scene_with(path: &Path, overrides: &[String]) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::new(SceneErrorKind::Io(e)).in_file(path.to_path_buf()))?;
-    parse_scene_with(&text, &default_name(path), overrides).map_err(|e| e.in_file(path.to_path_buf()))
+    let text = read_bounded(path, MAX_SCENE_BYTES).map_err(|e| SceneError::new(SceneErrorKind::Io(e)).in_file(path.to_path_buf()))?;
+    parse_scene_with(&text, &default_name(path), overrides).map_err(|e| match (&e.kind, overridden(&e, overrides)) {
+        // The value came from the command line, not from the file.
+        (SceneErrorKind::Syntax(m), _) if m.starts_with("--set ") => SceneError::from(SceneErrorKind::Conflict(m.clone())),
+        (_, Some(o)) => SceneError::from(SceneErrorKind::Conflict(format!("--set {o}: {}", e.kind))),
+        _ => e.in_file(path.to_path_buf()),
+    })
+}
+
+/// The largest scene file read (bytes): the biggest shipped scene is a few kB, a sweep of
+/// three 1000-value lists about 20 kB.
+pub const MAX_SCENE_BYTES: u64 = 1 << 20;
+
+/// Reads a text file of at most `limit` bytes. Anything but a regular file (a FIFO, a
+/// device such as /dev/zero, a folder) is refused before it is opened, so the read never
+/// blocks or runs without end.
+pub fn read_bounded(path: &Path, limit: u64) -> std::io::Result<String> {
+    use std::io::{Error, ErrorKind, Read};
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() { "a folder" } else { "not a regular file (a pipe, socket or device)" };
+        return Err(Error::new(ErrorKind::InvalidInput, format!("{what}; a scene must be a regular file")));
+    }
+    if meta.len() > limit {
+        return Err(Error::new(ErrorKind::InvalidInput, format!("{} bytes, more than the limit of {limit} bytes", meta.len())));
+    }
+    let mut text = String::new();
+    std::fs::File::open(path)?.take(limit + 1).read_to_string(&mut text)?;
+    if text.len() as u64 > limit {
+        return Err(Error::new(ErrorKind::InvalidInput, format!("more than the limit of {limit} bytes")));
+    }
+    Ok(text)
+}
+
+/// The `--set KEY=VALUE` whose key the error is about, if any.
+fn overridden<'a>(e: &SceneError, overrides: &'a [String]) -> Option<&'a String> {
+    let path = match &e.kind {
+        SceneErrorKind::UnknownKey { path, .. } | SceneErrorKind::WrongType { path, .. } | SceneErrorKind::NotAllowed { path, .. } => path.as_str(),
+        _ => return None,
+    };
+    // The last override of that key (or of the list it indexes) wins.
+    let base = path.split('[').next().unwrap_or(path);
+    overrides.iter().rev().find(|o| o.split_once('=').is_some_and(|(k, _)| k.trim() == base || base.starts_with(&format!("{}.", k.trim())) || k.trim().starts_with(&format!("{base}."))))
 }
 
 fn default_name(path: &Path) -> String {
@@ -327,7 +368,9 @@ impl Scene {
                 .into());
             }
         }
-        for point in self.points() {
+        // Each list value once and the lists' corners, never every combination (a sweep
+        // of three 1000-value lists has 10^9 of them).
+        for point in self.check_points() {
             point.validate_kinematics()?;
         }
         Ok(())
@@ -396,7 +439,7 @@ impl Scene {
             }
         }
         if e.kinematics == KinematicsModel::Uniform && self.operating.tilt_angle != 90.0 {
-            w.push(format!("operating.tilt_angle = {} deg is ignored by effects.kinematics = \"uniform\" (no spin)", self.operating.tilt_angle));
+            w.push(format!("operating.tilt_angle = {} deg is ignored by effects.kinematics = \"uniform\" (no spin)", fmt_num(self.operating.tilt_angle)));
         }
         w
     }

@@ -77,6 +77,8 @@ pub enum Kind {
     Text,
     /// One of the listed strings.
     Choice(&'static [&'static str]),
+    /// An array (possibly empty) of distinct strings, each one of the listed ones.
+    ChoiceList(&'static [&'static str]),
     /// A sub-table with its own keys.
     Table(&'static [Field]),
 }
@@ -121,6 +123,7 @@ impl Field {
             Kind::Bool => format!("{}, true or false", self.what),
             Kind::Text => self.what.to_string(),
             Kind::Choice(c) => format!("{}: one of {}", self.what, quoted_list(c)),
+            Kind::ChoiceList(c) => format!("{}: an array of {}", self.what, quoted_list(c)),
             Kind::Table(_) => self.what.to_string(),
         }
     }
@@ -139,6 +142,7 @@ impl Field {
             Kind::NumberList(_) => "a non-empty array of numbers",
             Kind::Bool => "a boolean",
             Kind::Text | Kind::Choice(_) => "a string",
+            Kind::ChoiceList(_) => "an array of strings",
             Kind::Table(_) => "a table",
         };
         format!("{t} ({})", self.description())
@@ -334,6 +338,26 @@ fn check_value(
             }
             _ => return Err(wrong()),
         },
+        Kind::ChoiceList(choices) => match value {
+            Value::Array(items) => {
+                for (i, item) in items.iter().enumerate() {
+                    let p = format!("{path}[{i}]");
+                    match item {
+                        Value::String(s) if choices.contains(&s.as_str()) => {
+                            if items[..i].contains(item) {
+                                return Err(SceneErrorKind::NotAllowed { path: p, value: format!("\"{s}\""), allowed: "is listed twice".into() });
+                            }
+                        }
+                        Value::String(s) => {
+                            let hint = closest(s, choices.iter().copied()).map(|c| format!(" (did you mean \"{c}\"?)")).unwrap_or_default();
+                            return Err(SceneErrorKind::NotAllowed { path: p, value: format!("\"{s}\""), allowed: format!("must be one of {}{hint}", quoted_list(choices)) });
+                        }
+                        _ => return Err(SceneErrorKind::WrongType { path: p, expected: field.expected(), found: describe_value(item) }),
+                    }
+                }
+            }
+            _ => return Err(wrong()),
+        },
         Kind::Table(sub) => match value {
             Value::Table(t) => check_table(root, t, sub, path)?,
             _ => return Err(wrong()),
@@ -401,6 +425,7 @@ fn write_section(
                 Kind::Bool => "true, false".into(),
                 Kind::Text => "non-empty string".into(),
                 Kind::Choice(c) => quoted_list(c),
+                Kind::ChoiceList(c) => format!("array of {}", quoted_list(c)),
                 Kind::Table(_) => unreachable!(),
             };
             let note = if f.note.is_empty() {

@@ -6,7 +6,7 @@ pub mod summary;
 pub mod vtu;
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The temporary name a file is written under before its final rename (same folder).
 fn temporary_path(path: &Path) -> std::path::PathBuf {
@@ -42,13 +42,120 @@ pub fn write_atomic_with(path: &Path, write: impl FnOnce(&Path) -> Result<(), St
     result
 }
 
-/// Checks, before any solve, that `dir` exists or can be created and is writable.
-pub fn prepare_output_dir(dir: &Path) -> Result<(), String> {
+/// Name of the lock file a run keeps in its output folder while it runs.
+pub const LOCK_FILE: &str = ".ehl-petsc.lock";
+
+/// An output folder claimed by this run: created if needed, locked against other runs.
+#[derive(Debug)]
+pub struct OutputClaim {
+    dir: PathBuf,
+    /// The outermost folder this run created (None: the folder existed).
+    created: Option<PathBuf>,
+    lock: PathBuf,
+}
+
+fn host_name() -> String {
+    let mut buf = [0u8; 256];
+    // SAFETY: gethostname writes at most buf.len() bytes into buf.
+    if unsafe { libc::gethostname(buf.as_mut_ptr() as *mut libc::c_char, buf.len()) } != 0 {
+        return "?".into();
+    }
+    let end = buf.iter().position(|&b| b == 0).unwrap_or(buf.len());
+    String::from_utf8_lossy(&buf[..end]).into_owned()
+}
+
+/// Claims `dir` for this run (rank 0, before any solve): creates it (and its missing
+/// parents) and writes the lock file [`LOCK_FILE`] with this process's id and host, which
+/// doubles as the test that the folder is writable. A folder whose lock names a live
+/// process (on this host) or another host is in use: refused. A lock left by a process
+/// that no longer exists (killed) is taken over.
+pub fn claim_output_dir(dir: &Path) -> Result<OutputClaim, String> {
+    let mut created = None;
+    let mut a = Some(dir);
+    while let Some(p) = a.filter(|p| !p.as_os_str().is_empty() && !p.exists()) {
+        created = Some(p.to_path_buf());
+        a = p.parent();
+    }
     std::fs::create_dir_all(dir).map_err(|e| format!("output folder '{}' cannot be created: {e}", dir.display()))?;
-    let probe = dir.join(format!(".write-test-{}", std::process::id()));
-    std::fs::write(&probe, b"ok").map_err(|e| format!("output folder '{}' is not writable: {e}", dir.display()))?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
+    let claim = OutputClaim { dir: dir.to_path_buf(), created, lock: dir.join(LOCK_FILE) };
+    let me = format!("{} {}\n", std::process::id(), host_name());
+    for attempt in 0..2 {
+        match std::fs::OpenOptions::new().write(true).create_new(true).open(&claim.lock) {
+            Ok(mut f) => {
+                if let Err(e) = f.write_all(me.as_bytes()).and_then(|()| f.sync_all()) {
+                    drop(f);
+                    claim.release(false);
+                    return Err(format!("output folder '{}' is not writable: {e}", dir.display()));
+                }
+                return Ok(claim);
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && attempt == 0 => {
+                let text = std::fs::read_to_string(&claim.lock).unwrap_or_default();
+                let mut w = text.split_whitespace();
+                let (pid, host) = (w.next().and_then(|p| p.parse::<u32>().ok()), w.next().unwrap_or(""));
+                let alive = match pid {
+                    Some(pid) if host == host_name() => Path::new(&format!("/proc/{pid}")).exists(),
+                    // Another host (a shared file system): cannot tell, so it is in use.
+                    Some(_) => true,
+                    None => false,
+                };
+                if alive {
+                    return Err(format!(
+                        "output folder '{}' is in use by another run (process {} on host {host}; lock file {}); choose another folder with --output, or remove the lock file if no run uses the folder",
+                        dir.display(),
+                        pid.map_or("?".into(), |p| p.to_string()),
+                        claim.lock.display()
+                    ));
+                }
+                // A stale lock (its process has ended): take it over.
+                let _ = std::fs::remove_file(&claim.lock);
+            }
+            Err(e) => {
+                claim.release(false);
+                return Err(format!("output folder '{}' is not writable: {e}", dir.display()));
+            }
+        }
+    }
+    Err(format!("output folder '{}': cannot take its lock file {}", dir.display(), claim.lock.display()))
+}
+
+impl OutputClaim {
+    /// The claimed folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Removes the lock; after a failed run also the folders this run created, when they
+    /// hold nothing (a failed run leaves nothing it created).
+    pub fn release(&self, success: bool) {
+        let _ = std::fs::remove_file(&self.lock);
+        if success {
+            return;
+        }
+        if let Some(top) = &self.created {
+            let mut d = Some(self.dir.as_path());
+            while let Some(p) = d {
+                if std::fs::remove_dir(p).is_err() || p == top.as_path() {
+                    break;
+                }
+                d = p.parent();
+            }
+        }
+    }
+}
+
+/// Moves every file of `staging` into `dir` (an old summary.json removed first, the new
+/// one moved last, so that a summary always describes the files next to it) and removes
+/// `staging`.
+pub fn publish(staging: &Path, dir: &Path) -> Result<(), String> {
+    let err = |e: std::io::Error| format!("cannot move the results from {} to {}: {e}", staging.display(), dir.display());
+    let mut names: Vec<std::ffi::OsString> = std::fs::read_dir(staging).map_err(err)?.filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    names.sort_by_key(|n| n == "summary.json");
+    let _ = std::fs::remove_file(dir.join("summary.json"));
+    for n in names {
+        std::fs::rename(staging.join(&n), dir.join(&n)).map_err(err)?;
+    }
+    std::fs::remove_dir(staging).map_err(err)
 }
 
 /// Peak resident memory of this process in MiB (getrusage ru_maxrss).

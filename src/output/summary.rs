@@ -83,7 +83,7 @@ pub struct MeshSummary {
     pub dofs_total: usize,
     pub contact_triangles: usize,
     pub contact_size_a: f64,
-    pub worst_quality: f64,
+    pub worst_quality: Option<f64>,
     pub worst_quality_measure: String,
     /// Dry runs only.
     #[serde(default, skip_serializing_if = "Option::is_none")]

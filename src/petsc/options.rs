@@ -116,3 +116,27 @@ impl Group {
         Ok(())
     }
 }
+
+/// The options of the database that nobody queried (`-options_left` style), without those
+/// our own code set as defaults: the user's misspelt or irrelevant options. Names with
+/// their leading dash, values if any.
+pub fn unused() -> Result<Vec<(String, Option<String>)>> {
+    let mut n: super::ffi::PetscInt = 0;
+    let mut names: *mut *mut std::os::raw::c_char = std::ptr::null_mut();
+    let mut values: *mut *mut std::os::raw::c_char = std::ptr::null_mut();
+    pcall!(super::ffi::PetscOptionsLeftGet(std::ptr::null_mut(), &mut n, &mut names, &mut values))?;
+    let text = |p: *mut std::os::raw::c_char| (!p.is_null()).then(|| unsafe { std::ffi::CStr::from_ptr(p) }.to_string_lossy().into_owned());
+    let ours = OURS.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    let mut out = Vec::new();
+    for k in 0..n.max(0) as usize {
+        // SAFETY: PETSc returned arrays of n entries (names non-null, values may be null).
+        let (name, value) = unsafe { (text(*names.add(k)), if values.is_null() { None } else { text(*values.add(k)) }) };
+        let Some(name) = name else { continue };
+        let name = format!("-{}", name.trim_start_matches('-'));
+        if !ours.contains(&name) {
+            out.push((name, value));
+        }
+    }
+    pcall!(super::ffi::PetscOptionsLeftRestore(std::ptr::null_mut(), &mut n, &mut names, &mut values))?;
+    Ok(out)
+}

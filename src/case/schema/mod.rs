@@ -107,7 +107,28 @@ pub struct Scene {
     /// Accuracy target and adaptive refinement.
     #[serde(default)]
     pub accuracy: Accuracy,
+    /// Plausibility limits the user accepts (see [`super::plausible`]).
+    #[serde(default)]
+    pub checks: Checks,
 }
+
+/// `[checks]`: the plausibility checks a scene accepts outside their usual range.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Checks {
+    /// Names of derived quantities allowed outside their usual (soft) range, e.g.
+    /// `["memory"]` for a run over several nodes.
+    pub accept: Vec<String>,
+}
+
+/// Keys of `[checks]`.
+pub const CHECKS_FIELDS: &[Field] = &[f!(
+    "accept",
+    "derived quantities allowed outside their usual range (a warning instead of an error; docs/robustness.md)",
+    "",
+    Kind::ChoiceList(super::plausible::ACCEPT_NAMES),
+    Presence::Default("[] (none)")
+)];
 
 /// Keys of the top level of the scene file.
 pub const SCENE_FIELDS: &[Field] = &[
@@ -187,6 +208,13 @@ pub const SCENE_FIELDS: &[Field] = &[
         "",
         Kind::Table(ACCURACY_FIELDS),
         Presence::Default("target 0.01 for a lubricated scene without [mesh]; none otherwise")
+    ),
+    f!(
+        "checks",
+        "physical plausibility checks: quantities accepted outside their usual range",
+        "",
+        Kind::Table(CHECKS_FIELDS),
+        Presence::Default("none accepted")
     ),
 ];
 
