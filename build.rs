@@ -21,10 +21,9 @@ fn mpi_include_dirs() -> Vec<PathBuf> {
         return lib.include_paths;
     }
     match Command::new("mpicc").arg("--showme:compile").output() {
-        Ok(out) if out.status.success() => String::from_utf8_lossy(&out.stdout)
-            .split_whitespace()
-            .filter_map(|f| f.strip_prefix("-I").map(PathBuf::from))
-            .collect(),
+        Ok(out) if out.status.success() => {
+            String::from_utf8_lossy(&out.stdout).split_whitespace().filter_map(|f| f.strip_prefix("-I").map(PathBuf::from)).collect()
+        }
         _ => fail(&format!("MPI headers not found (neither `pkg-config ompi-c` nor `mpicc`): {INSTALL_HINT}")),
     }
 }
@@ -42,7 +41,10 @@ fn check_petsc_config(include_dirs: &[PathBuf]) {
         fail(&format!("{} has 64-bit indices; ehl-petsc needs 32-bit PetscInt (Debian's petsc-dev)", conf.display()));
     }
     if !defined("PETSC_USE_REAL_DOUBLE") || defined("PETSC_USE_COMPLEX") {
-        fail(&format!("{} is not a real double-precision build; ehl-petsc needs PetscScalar = double (petsc-dev's real flavour)", conf.display()));
+        fail(&format!(
+            "{} is not a real double-precision build; ehl-petsc needs PetscScalar = double (petsc-dev's real flavour)",
+            conf.display()
+        ));
     }
     if !defined("PETSC_HAVE_MUMPS") {
         fail(&format!("{} was built without MUMPS; ehl-petsc's direct solver needs it", conf.display()));
@@ -53,9 +55,8 @@ fn check_petsc_config(include_dirs: &[PathBuf]) {
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=src/petsc/wrapper.h");
-    let petsc = pkg_config::Config::new()
-        .probe("PETSc")
-        .unwrap_or_else(|e| fail(&format!("PETSc not found by pkg-config ({e}); {INSTALL_HINT}")));
+    let petsc =
+        pkg_config::Config::new().probe("PETSc").unwrap_or_else(|e| fail(&format!("PETSc not found by pkg-config ({e}); {INSTALL_HINT}")));
     check_petsc_config(&petsc.include_paths);
     for dir in &petsc.link_paths {
         // Debian keeps libpetsc_real outside the default loader path: embed an rpath.
@@ -80,7 +81,5 @@ fn main() {
         .generate()
         .unwrap_or_else(|e| fail(&format!("bindgen failed on PETSc's headers ({e}); is libclang-dev installed? {INSTALL_HINT}")));
     let out = PathBuf::from(env::var("OUT_DIR").unwrap()).join("petsc_bindings.rs");
-    bindings
-        .write_to_file(Path::new(&out))
-        .unwrap_or_else(|e| fail(&format!("cannot write {}: {e}", out.display())));
+    bindings.write_to_file(Path::new(&out)).unwrap_or_else(|e| fail(&format!("cannot write {}: {e}", out.display())));
 }

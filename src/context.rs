@@ -62,7 +62,8 @@ impl Context {
 
     /// Creates the output subfolder `dir` (rank 0; the outcome is shared). Collective.
     pub fn create_dir(&self, dir: &std::path::Path) -> Result<(), String> {
-        let made = if self.rank == 0 { std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display())) } else { Ok(()) };
+        let made =
+            if self.rank == 0 { std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display())) } else { Ok(()) };
         collective::agree(&self.world, made)
     }
 
@@ -85,7 +86,16 @@ impl Context {
 
 /// Keys of summary.json that may be null (absent optional values, such as the mesh quality
 /// of rigid solids, which have no 3D mesh), not non-finite numbers.
-const MAY_BE_NULL: &[&str] = &["worst_quality", "spin_centre_z_m", "hc_hamrock_dowson_m", "hm_hamrock_dowson_m", "moes", "entrainment_speed_m_s", "snes_reason", "path"];
+const MAY_BE_NULL: &[&str] = &[
+    "worst_quality",
+    "spin_centre_z_m",
+    "hc_hamrock_dowson_m",
+    "hm_hamrock_dowson_m",
+    "moes",
+    "entrainment_speed_m_s",
+    "snes_reason",
+    "path",
+];
 
 /// The dotted paths of the nulls in `v` outside [`MAY_BE_NULL`] and the scene.
 fn null_numbers(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {

@@ -61,19 +61,44 @@ pub fn read(comm: petsc::ffi::MPI_Comm) -> petsc::Result<&'static EhlOptions> {
     }
     let d = EhlOptions::default();
     let mut g = petsc::options::Group::begin(comm, "EHL solver options", "EHL")?;
-    let monitor = g.bool("-ehl_monitor", "Print Newton diagnostics per iteration (block residual norms, worst rows, film limiter)", d.monitor)?;
-    let check_jacobian = g.bool("-ehl_check_jacobian", "Check the monolithic Jacobian block by block against finite differences at the start", d.check_jacobian)?;
-    let supg_delta = g.real("-ehl_supg_delta", "Factor on the SUPG parameter tau of the Reynolds element", d.supg_delta)?.unwrap_or(d.supg_delta);
+    let monitor =
+        g.bool("-ehl_monitor", "Print Newton diagnostics per iteration (block residual norms, worst rows, film limiter)", d.monitor)?;
+    let check_jacobian = g.bool(
+        "-ehl_check_jacobian",
+        "Check the monolithic Jacobian block by block against finite differences at the start",
+        d.check_jacobian,
+    )?;
+    let supg_delta =
+        g.real("-ehl_supg_delta", "Factor on the SUPG parameter tau of the Reynolds element", d.supg_delta)?.unwrap_or(d.supg_delta);
     let floor_default = crate::reynolds::cavitation::PRESSURE_STEP_FLOOR;
     let clip = g.bool("-ehl_pressure_step_clip", "Clip a Newton step's nodal pressure at -ehl_pressure_step_floor", true)?;
-    let floor = g.real("-ehl_pressure_step_floor", "Lowest nodal pressure a Newton step may reach (dimensionless, P/p_H)", floor_default)?.unwrap_or(floor_default);
-    let film_limiter = g.bool("-ehl_film_limiter", "Limit each Newton step so that the film keeps a fifth of its thickness at every node", d.film_limiter)?;
+    let floor = g
+        .real("-ehl_pressure_step_floor", "Lowest nodal pressure a Newton step may reach (dimensionless, P/p_H)", floor_default)?
+        .unwrap_or(floor_default);
+    let film_limiter = g.bool(
+        "-ehl_film_limiter",
+        "Limit each Newton step so that the film keeps a fifth of its thickness at every node",
+        d.film_limiter,
+    )?;
     let row_scaling = g.bool("-ehl_row_scaling", "Scale each Reynolds row by its diagonal at the start of a solve", d.row_scaling)?;
     let skip_plain = g.bool("-ehl_skip_plain", "Skip plain Newton from the start and go to the continuation (for tests)", d.skip_plain)?;
-    let fail_point = g.int("-ehl_fail_point", "Make the K-th operating point of a sweep fail (fault injection, for tests)", 0)?.filter(|&k| k > 0).map(|k| k as usize);
+    let fail_point = g
+        .int("-ehl_fail_point", "Make the K-th operating point of a sweep fail (fault injection, for tests)", 0)?
+        .filter(|&k| k > 0)
+        .map(|k| k as usize);
     let plot_font = g.string("-ehl_plot_font", "TrueType font file for the plots", crate::output::plot::FONT_PATH)?;
     g.end()?;
-    let o = EhlOptions { monitor, check_jacobian, supg_delta, pressure_step_floor: clip.then_some(floor), film_limiter, row_scaling, skip_plain, fail_point, plot_font };
+    let o = EhlOptions {
+        monitor,
+        check_jacobian,
+        supg_delta,
+        pressure_step_floor: clip.then_some(floor),
+        film_limiter,
+        row_scaling,
+        skip_plain,
+        fail_point,
+        plot_font,
+    };
     Ok(OPTIONS.get_or_init(|| o))
 }
 

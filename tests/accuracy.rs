@@ -49,7 +49,9 @@ fn a_moes_point_is_refined_to_its_target() {
 /// A target where refinement cannot apply is refused before anything runs, naming the key.
 #[test]
 fn a_target_is_refused_where_it_cannot_apply() {
-    for (scene, why) in [("cases/dry-hertz.toml", "dry"), ("cases/examples/rigid-isoviscous.toml", "elastic"), ("cases/paper/fig7-8.toml", "sweep")] {
+    for (scene, why) in
+        [("cases/dry-hertz.toml", "dry"), ("cases/examples/rigid-isoviscous.toml", "elastic"), ("cases/paper/fig7-8.toml", "sweep")]
+    {
         let out = run_plain(&["--check", repo().join(scene).to_str().unwrap(), "--set", "accuracy.target=0.01"]);
         assert_eq!(out.status.code(), Some(2), "{scene}: {}", text(&out));
         let t = text(&out);

@@ -33,17 +33,11 @@ fn link_targets(text: &str) -> Vec<&str> {
 fn readme_is_short_and_links_every_doc() {
     let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
     let lines = readme.lines().count();
-    assert!(
-        lines <= 300,
-        "README.md has {lines} lines; move reference text to docs/"
-    );
+    assert!(lines <= 300, "README.md has {lines} lines; move reference text to docs/");
     let links = link_targets(&readme);
     for f in docs() {
         let name = format!("docs/{}", f.file_name().unwrap().to_str().unwrap());
-        assert!(
-            links.contains(&name.as_str()),
-            "README.md does not link {name}"
-        );
+        assert!(links.contains(&name.as_str()), "README.md does not link {name}");
     }
 }
 
@@ -55,30 +49,16 @@ fn documents_stay_inside_the_repository() {
     for f in files {
         let text = std::fs::read_to_string(&f).unwrap();
         for outside in ["../shared", "/work/shared"] {
-            assert!(
-                !text.contains(outside),
-                "{} refers to {outside}, outside the repository",
-                f.display()
-            );
+            assert!(!text.contains(outside), "{} refers to {outside}, outside the repository", f.display());
         }
         for target in link_targets(&text) {
             // Resolve the link against the file's folder without touching the disk: a link
             // may name a document another branch adds, but never a path above the root.
-            let mut depth = f
-                .parent()
-                .unwrap()
-                .strip_prefix(&root)
-                .unwrap()
-                .components()
-                .count();
+            let mut depth = f.parent().unwrap().strip_prefix(&root).unwrap().components().count();
             for c in Path::new(target).components() {
                 match c {
                     Component::ParentDir => {
-                        assert!(
-                            depth > 0,
-                            "{}: link {target} leaves the repository",
-                            f.display()
-                        );
+                        assert!(depth > 0, "{}: link {target} leaves the repository", f.display());
                         depth -= 1;
                     }
                     Component::Normal(_) => depth += 1,

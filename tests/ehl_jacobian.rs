@@ -9,7 +9,16 @@ fn ehl_jacobian_matches_finite_differences() {
     let scene = table2_ue2_with_mesh("contact_size = 1.0\ngrowth = 2.0");
     let path = write_scene(&dir, "scene.toml", &scene);
     let mut cmd = std::process::Command::new("mpirun");
-    cmd.args(["-n", "2"]).arg(binary()).args([path.as_str(), "--set", "reynolds.coupling=monolithic", "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "0", "-ehl_check_jacobian"]);
+    cmd.args(["-n", "2"]).arg(binary()).args([
+        path.as_str(),
+        "--set",
+        "reynolds.coupling=monolithic",
+        "--output",
+        dir.join("out").to_str().unwrap(),
+        "-snes_max_it",
+        "0",
+        "-ehl_check_jacobian",
+    ]);
     cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OPENBLAS_NUM_THREADS", "1");
     let out = cmd.output().unwrap();
     let t = text(&out);
@@ -37,7 +46,14 @@ fn condensed_jacobian_matches_finite_differences() {
     let scene = table2_ue2_with_mesh("contact_size = 1.0\ngrowth = 2.0");
     let path = write_scene(&dir, "scene.toml", &scene);
     let mut cmd = std::process::Command::new("mpirun");
-    cmd.args(["-n", "2"]).arg(binary()).args([path.as_str(), "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "1", "-snes_test_jacobian"]);
+    cmd.args(["-n", "2"]).arg(binary()).args([
+        path.as_str(),
+        "--output",
+        dir.join("out").to_str().unwrap(),
+        "-snes_max_it",
+        "1",
+        "-snes_test_jacobian",
+    ]);
     cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OPENBLAS_NUM_THREADS", "1");
     let out = cmd.output().unwrap();
     let t = text(&out);
@@ -62,7 +78,16 @@ fn newton_norms_on(tag: &str, monolithic: bool, ranks: usize) -> Vec<f64> {
     let path = write_scene(&dir, "scene.toml", &scene);
     let mut cmd = std::process::Command::new("mpirun");
     let coupling = if monolithic { "reynolds.coupling=monolithic" } else { "reynolds.coupling=condensed" };
-    cmd.args(["-n", &ranks.to_string()]).arg(binary()).args([path.as_str(), "--set", coupling, "--output", dir.join("out").to_str().unwrap(), "-snes_max_it", "3", "-snes_monitor"]);
+    cmd.args(["-n", &ranks.to_string()]).arg(binary()).args([
+        path.as_str(),
+        "--set",
+        coupling,
+        "--output",
+        dir.join("out").to_str().unwrap(),
+        "-snes_max_it",
+        "3",
+        "-snes_monitor",
+    ]);
     if monolithic {
         // Exact Newton, as the monolithic coupling takes from the Hertz start by default
         // (from a start near the solution it reuses the LU over three steps with GMRES to
@@ -70,12 +95,18 @@ fn newton_norms_on(tag: &str, monolithic: bool, ranks: usize) -> Vec<f64> {
         // tolerance); the comparison is of the discrete problem, so both take exact steps.
         cmd.args(["-snes_lag_preconditioner", "1", "-ksp_type", "preonly", "-snes_ksp_ew", "false"]);
     }
-    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OMPI_MCA_rmaps_base_oversubscribe", "1").env("OPENBLAS_NUM_THREADS", "1");
+    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
+        .env("OPENBLAS_NUM_THREADS", "1");
     let out = cmd.output().unwrap();
     let t = text(&out);
     let used = if monolithic { "coupling: monolithic" } else { "coupling: condensed" };
     assert!(t.contains(used), "the run did not use the requested coupling ({used}):\n{t}");
-    t.lines().filter(|l| l.contains("SNES Function norm")).map(|l| l.rsplit(' ').find(|w| !w.is_empty()).unwrap().parse().unwrap()).collect()
+    t.lines()
+        .filter(|l| l.contains("SNES Function norm"))
+        .map(|l| l.rsplit(' ').find(|w| !w.is_empty()).unwrap().parse().unwrap())
+        .collect()
 }
 
 /// The condensed system (elastic block eliminated onto the contact face through MUMPS's

@@ -31,7 +31,10 @@ fn interrupt_run(name: &str, wait_for: &str, sig: i32, target: Target) -> (Optio
     let scene = repo().join("cases/paper/table2-ue2.toml");
     let mut cmd = Command::new("mpirun");
     cmd.args(["-n", "2"]).arg(binary()).arg(&scene).arg("--output").arg(&out);
-    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").env("OMPI_MCA_rmaps_base_oversubscribe", "1").env("OPENBLAS_NUM_THREADS", "1");
+    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
+        .env("OPENBLAS_NUM_THREADS", "1");
     let mut child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("mpirun");
     let pid = child.id();
     let stdout = child.stdout.take().unwrap();
@@ -51,7 +54,11 @@ fn interrupt_run(name: &str, wait_for: &str, sig: i32, target: Target) -> (Optio
         _ => {
             let ranks = children(pid);
             assert_eq!(ranks.len(), 2, "expected 2 rank processes under mpirun, found {ranks:?}");
-            if target == Target::OneRank { vec![ranks[1]] } else { ranks }
+            if target == Target::OneRank {
+                vec![ranks[1]]
+            } else {
+                ranks
+            }
         }
     };
     for p in pids {
@@ -63,7 +70,9 @@ fn interrupt_run(name: &str, wait_for: &str, sig: i32, target: Target) -> (Optio
 
 /// Names of the files in `dir` (none if it does not exist).
 fn files_in(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir).map(|d| d.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect()).unwrap_or_default()
+    std::fs::read_dir(dir)
+        .map(|d| d.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect())
+        .unwrap_or_default()
 }
 
 fn assert_no_results(out: &Path) {
@@ -117,11 +126,23 @@ fn regression_runner_catches_a_perturbed_reference() {
     std::fs::create_dir_all(data.join("ref")).unwrap();
     let src = repo().join("tests/regress");
     std::fs::copy(src.join("tolerances.toml"), data.join("tolerances.toml")).unwrap();
-    let line = std::fs::read_to_string(src.join("quick.list")).unwrap().lines().find(|l| l.starts_with("table2-ue2-coarse")).expect("quick tier lists table2-ue2-coarse").to_string();
+    let line = std::fs::read_to_string(src.join("quick.list"))
+        .unwrap()
+        .lines()
+        .find(|l| l.starts_with("table2-ue2-coarse"))
+        .expect("quick tier lists table2-ue2-coarse")
+        .to_string();
     std::fs::write(data.join("quick.list"), format!("{line}\n")).unwrap();
     let reference = std::fs::read_to_string(src.join("ref/table2-ue2-coarse.json")).unwrap();
     let run = |label: &str| {
-        let out = Command::new(repo().join("ci/regress")).args(["-t", "quick", "-r", "1", "-o"]).arg(data.parent().unwrap().join(label)).env("REGRESS_DATA", &data).env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1").output().unwrap();
+        let out = Command::new(repo().join("ci/regress"))
+            .args(["-t", "quick", "-r", "1", "-o"])
+            .arg(data.parent().unwrap().join(label))
+            .env("REGRESS_DATA", &data)
+            .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+            .output()
+            .unwrap();
         (out.status.code(), String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr))
     };
     std::fs::write(data.join("ref/table2-ue2-coarse.json"), &reference).unwrap();

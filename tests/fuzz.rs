@@ -102,11 +102,7 @@ const SECTIONS: &[&str] = &[
 /// Where the numbers, keys and values of `text` are: (line index, byte start, byte end) of
 /// each value after an `=`.
 fn value_spans(lines: &[String]) -> Vec<(usize, usize)> {
-    lines
-        .iter()
-        .enumerate()
-        .filter_map(|(i, l)| l.find('=').filter(|_| !l.trim_start().starts_with('#')).map(|p| (i, p + 1)))
-        .collect()
+    lines.iter().enumerate().filter_map(|(i, l)| l.find('=').filter(|_| !l.trim_start().starts_with('#')).map(|p| (i, p + 1))).collect()
 }
 
 /// One mutation of the scene text.
@@ -160,11 +156,7 @@ fn mutate(text: &str, rng: &mut Rng) -> String {
         // Insert a section header or a key.
         7 => {
             let j = rng.below(lines.len() + 1);
-            let l = if rng.below(2) == 0 {
-                rng.pick(SECTIONS).to_string()
-            } else {
-                format!("{} = {}", rng.pick(KEYS), rng.pick(VALUES))
-            };
+            let l = if rng.below(2) == 0 { rng.pick(SECTIONS).to_string() } else { format!("{} = {}", rng.pick(KEYS), rng.pick(VALUES)) };
             lines.insert(j, l);
         }
         // A sweep or an accept list of odd content.

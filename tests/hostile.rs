@@ -200,7 +200,8 @@ fn cases(dir: &Path) -> Vec<Case> {
     let mut last = case("option-without-value", &[&c2, "--check", "--output"], 2, &["'--output' needs a value"]);
     last.own_output = true;
     v.push(last);
-    let mut no_value = case("option-without-value-before-another", &[&c2, "--output", "--check"], 2, &["'--output' needs a value", "'--check'"]);
+    let mut no_value =
+        case("option-without-value-before-another", &[&c2, "--output", "--check"], 2, &["'--output' needs a value", "'--check'"]);
     no_value.own_output = true;
     v.push(no_value);
     let mut out_file = case(
@@ -355,7 +356,9 @@ fn hostile_inputs_on_one_rank() {
 #[test]
 fn hostile_runs_under_mpirun_one_rank() {
     let (n, failures) = run_all(1, "mpirun-n1", |c| {
-        c.own_output || !c.env.is_empty() || ["misspelt-option", "second-scene", "load-1e308", "contact-size-2", "fifo-as-scene"].contains(&c.name)
+        c.own_output
+            || !c.env.is_empty()
+            || ["misspelt-option", "second-scene", "load-1e308", "contact-size-2", "fifo-as-scene"].contains(&c.name)
     });
     assert!(n >= 8, "only {n} cases");
     assert!(failures.is_empty(), "{} of {n} cases failed:\n{}", failures.len(), failures.join("\n"));

@@ -41,7 +41,20 @@ fn convergence_study_writes_its_table_and_plots() {
     assert!(text(&bad).contains("--convergence-study 9"), "{}", text(&bad));
     assert!(!dir.join("bad").exists(), "a refused study must not create its output folder");
     // So is a first size the mesher cannot make.
-    let bad = mpirun(2, &["--convergence-study", "3", "--ladder", "ring", "--first-size", "0.1", path.as_str(), "--output", dir.join("bad").to_str().unwrap()]);
+    let bad = mpirun(
+        2,
+        &[
+            "--convergence-study",
+            "3",
+            "--ladder",
+            "ring",
+            "--first-size",
+            "0.1",
+            path.as_str(),
+            "--output",
+            dir.join("bad").to_str().unwrap(),
+        ],
+    );
     assert_eq!(bad.status.code(), Some(2), "{}", text(&bad));
     assert!(text(&bad).contains("--first-size 0.1"), "{}", text(&bad));
 }
@@ -58,7 +71,25 @@ fn sequenced_ring_ladder_switches_coupling() {
     let scene = std::fs::read_to_string(repo().join("cases/paper/table2-ue2.toml")).unwrap();
     let path = write_scene(&dir, "scene.toml", &scene);
     let out_dir = dir.join("out");
-    let out = mpirun(2, &["--convergence-study", "2", "--ladder", "ring", "--first-size", "0.0625", "--sequence", path.as_str(), "--set", "mesh.ring_inner=0.92", "--set", "mesh.ring_outer=1.02", "--output", out_dir.to_str().unwrap()]);
+    let out = mpirun(
+        2,
+        &[
+            "--convergence-study",
+            "2",
+            "--ladder",
+            "ring",
+            "--first-size",
+            "0.0625",
+            "--sequence",
+            path.as_str(),
+            "--set",
+            "mesh.ring_inner=0.92",
+            "--set",
+            "mesh.ring_outer=1.02",
+            "--output",
+            out_dir.to_str().unwrap(),
+        ],
+    );
     let t = text(&out);
     assert_eq!(out.status.code(), Some(0), "{t}");
     assert!(t.contains("coupling: condensed") && t.contains("coupling: monolithic"), "{t}");

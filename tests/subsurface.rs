@@ -47,10 +47,7 @@ fn dry_hertz_subsurface_matches_huber() {
         let (sz, sr) = huber_axis(d, NU);
         let tol = if d < 0.1 { 0.025 } else { 0.015 };
         let (sxx, syy, szz) = (v[1] / ph, v[2] / ph, v[3] / ph);
-        assert!(
-            (syy - sz).abs() < tol,
-            "depth {d:.3} a: sigma_y = {syy:.4} p_H, Huber {sz:.4}"
-        );
+        assert!((syy - sz).abs() < tol, "depth {d:.3} a: sigma_y = {syy:.4} p_H, Huber {sz:.4}");
         assert!(
             (sxx - sr).abs() < tol && (szz - sr).abs() < tol,
             "depth {d:.3} a: sigma_x = {sxx:.4}, sigma_z = {szz:.4} p_H, Huber sigma_r {sr:.4}"
@@ -70,14 +67,8 @@ fn dry_hertz_subsurface_matches_huber() {
     }
     let tau = 0.5 * num(&s, "subsurface.tresca_max_pa") / ph;
     let depth = num(&s, "subsurface.tresca_max_depth_m") / a;
-    assert!(
-        (tau / tmax - 1.0).abs() < 0.01,
-        "max shear {tau:.4} p_H vs Huber {tmax:.4} p_H"
-    );
-    assert!(
-        (depth - zmax).abs() < 0.03,
-        "max shear at depth {depth:.3} a vs Huber {zmax:.3} a"
-    );
+    assert!((tau / tmax - 1.0).abs() < 0.01, "max shear {tau:.4} p_H vs Huber {tmax:.4} p_H");
+    assert!((depth - zmax).abs() < 0.03, "max shear at depth {depth:.3} a vs Huber {zmax:.3} a");
     // The maximum lies on the axis (the load is axisymmetric).
     let r = num(&s, "subsurface.tresca_max_x_m").hypot(num(&s, "subsurface.tresca_max_z_m")) / a;
     assert!(r < 0.1, "max shear {r:.3} a off the axis");
@@ -115,25 +106,18 @@ fn check_hamilton(mu: f64) {
     let (a, ph) = (num(&s, "hertz.a_m"), num(&s, "hertz.ph_pa"));
     let (vref, xref, zref) = sliding_von_mises_max(NU, mu);
     let v = num(&s, "subsurface.von_mises_max_z0_pa") / ph;
-    let (x, d) = (
-        num(&s, "subsurface.von_mises_max_z0_x_m") / a,
-        num(&s, "subsurface.von_mises_max_z0_depth_m") / a,
+    let (x, d) = (num(&s, "subsurface.von_mises_max_z0_x_m") / a, num(&s, "subsurface.von_mises_max_z0_depth_m") / a);
+    eprintln!(
+        "mu = {mu}: von Mises max {v:.4} p_H at x = {x:.4} a, depth {d:.4} a; Hamilton {vref:.4} at x = {xref:.4} a, depth {zref:.4} a"
     );
-    eprintln!("mu = {mu}: von Mises max {v:.4} p_H at x = {x:.4} a, depth {d:.4} a; Hamilton {vref:.4} at x = {xref:.4} a, depth {zref:.4} a");
-    assert!(
-        (v / vref - 1.0).abs() < 0.02,
-        "mu = {mu}: von Mises max {v:.4} p_H vs Hamilton {vref:.4}"
-    );
+    assert!((v / vref - 1.0).abs() < 0.02, "mu = {mu}: von Mises max {v:.4} p_H vs Hamilton {vref:.4}");
     assert!(
         (x - xref).abs() < 0.05 && (d - zref).abs() < 0.05,
         "mu = {mu}: maximum at ({x:.3}, depth {d:.3}) a vs Hamilton ({xref:.3}, {zref:.3}) a"
     );
     // Over the whole region the maximum is the same (the plane of symmetry holds it).
     let v3 = num(&s, "subsurface.von_mises_max_pa") / ph;
-    assert!(
-        (v3 / v - 1.0).abs() < 0.01,
-        "3D maximum {v3:.4} vs plane {v:.4}"
-    );
+    assert!((v3 / v - 1.0).abs() < 0.01, "3D maximum {v3:.4} vs plane {v:.4}");
 }
 
 #[test]
@@ -173,36 +157,15 @@ fn lubricated_subsurface_outputs() {
         "operating.slide_to_roll=0.05",
     ];
     let out = mpirun(2, &args);
-    assert!(
-        out.status.success(),
-        "lubricated subsurface run failed:\n{}",
-        text(&out)
-    );
+    assert!(out.status.success(), "lubricated subsurface run failed:\n{}", text(&out));
     let s = summary(&dir);
-    for f in [
-        "subsurface.vtu",
-        "subsurface_axis.csv",
-        "subsurface_von_mises_xy.png",
-        "subsurface_tau_xy_zy.png",
-    ] {
+    for f in ["subsurface.vtu", "subsurface_axis.csv", "subsurface_von_mises_xy.png", "subsurface_tau_xy_zy.png"] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
     let pmax = num(&s, "pressure.pmax_pa");
     let comp = num(&s, "subsurface.compression_max_pa");
-    assert!(
-        (comp / pmax - 1.0).abs() < 0.1,
-        "largest compression {comp:.4e} Pa vs pmax {pmax:.4e} Pa"
-    );
-    let (vm, vm0) = (
-        num(&s, "subsurface.von_mises_max_pa"),
-        num(&s, "subsurface.pressure_only.von_mises_max_pa"),
-    );
-    assert!(
-        vm != vm0 && (vm / vm0 - 1.0).abs() < 0.02,
-        "von Mises max {vm:.4e} with friction, {vm0:.4e} without"
-    );
-    assert!(
-        num(&s, "subsurface.solve.seconds") > 0.0
-            && num(&s, "subsurface.solve.mumps_factor_mb") > 0.0
-    );
+    assert!((comp / pmax - 1.0).abs() < 0.1, "largest compression {comp:.4e} Pa vs pmax {pmax:.4e} Pa");
+    let (vm, vm0) = (num(&s, "subsurface.von_mises_max_pa"), num(&s, "subsurface.pressure_only.von_mises_max_pa"));
+    assert!(vm != vm0 && (vm / vm0 - 1.0).abs() < 0.02, "von Mises max {vm:.4e} with friction, {vm0:.4e} without");
+    assert!(num(&s, "subsurface.solve.seconds") > 0.0 && num(&s, "subsurface.solve.mumps_factor_mb") > 0.0);
 }

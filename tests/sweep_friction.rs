@@ -47,7 +47,15 @@ fn tilt_sweep_with_friction() {
     assert!(fx2 < fx90, "fx(2 deg) = {fx2} >= fx(90 deg) = {fx90}");
     // Paper finding 5: |fz| is orders of magnitude below fx.
     assert!(fz90.abs() < 0.1 * fx90, "fz {fz90} fx {fx90}");
-    for f in ["shear_x_map.png", "shear_z_map.png", "shear_profile.png", "velocity_ball.png", "velocity_disc.png", "velocity_sliding.png", "velocity_mean.png"] {
+    for f in [
+        "shear_x_map.png",
+        "shear_z_map.png",
+        "shear_profile.png",
+        "velocity_ball.png",
+        "velocity_disc.png",
+        "velocity_sliding.png",
+        "velocity_mean.png",
+    ] {
         let bytes = std::fs::read(out_dir.join("point_002").join(f)).unwrap();
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{f}");
     }

@@ -71,6 +71,10 @@ pub fn estimate(q: &[f64]) -> Option<f64> {
     Some(factor * d1 / q[n - 1].abs())
 }
 
+/// The outward fluxes of an edge at its two Gauss points summed over its triangles, the
+/// triangles (one or two) and how many there are.
+type EdgeFluxes = ([f64; 2], [usize; 2], u8);
+
 /// The indicator of every contact triangle of a converged level (on every rank: each holds
 /// the whole iterate).
 fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
@@ -83,7 +87,7 @@ fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
     let mut eta = vec![0.0; n];
     // Edge (low, high vertex id) -> outward fluxes at its Gauss points, ordered from the
     // low to the high vertex, summed over the two triangles that share it.
-    let mut jumps: HashMap<(u32, u32), ([f64; 2], [usize; 2], u8)> = HashMap::new();
+    let mut jumps: HashMap<(u32, u32), EdgeFluxes> = HashMap::new();
     for (k, tri) in mesh.contact_tris.iter().enumerate() {
         let verts = [0, 1, 2].map(|i| {
             let c = mesh.nodes[tri[i] as usize];
@@ -184,7 +188,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         }
         let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
         let (n_u, n_p) = setup.layout.counts();
-        let min_size = (0..setup.mesh.contact_tris.len()).map(|t| longest_edge(&fields, t)).fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
+        let min_size =
+            (0..setup.mesh.contact_tris.len()).map(|t| longest_edge(&fields, t)).fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
         let mut level = Level {
             elastic_unknowns: n_u,
             pressure_unknowns: n_p,
@@ -248,7 +253,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             }
         }
         if !marked.iter().any(|&m| m) {
-            return Err(format!("accuracy: target {target} not reached: every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"));
+            return Err(format!(
+                "accuracy: target {target} not reached: every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"
+            ));
         }
         field = Some(Arc::new(next_field(&fields, &marked, growth)));
         drop(solver);

@@ -114,10 +114,7 @@ pub fn check_petsc_args(petsc: &[String]) -> Result<(), String> {
 /// The rank of this process as the MPI launcher numbers it (0 when not launched by one),
 /// read before MPI is initialised so that a usage error is printed once, by rank 0.
 pub fn launcher_rank() -> usize {
-    ["OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK", "SLURM_PROCID"]
-        .iter()
-        .find_map(|k| std::env::var(k).ok()?.parse().ok())
-        .unwrap_or(0)
+    ["OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK", "SLURM_PROCID"].iter().find_map(|k| std::env::var(k).ok()?.parse().ok()).unwrap_or(0)
 }
 
 #[cfg(test)]
@@ -130,7 +127,9 @@ mod tests {
 
     #[test]
     fn our_options_anywhere_petsc_options_with_values() {
-        let r = split(&s(&["a.toml", "-ksp_type", "cg", "--check", "-ksp_view", "--set", "x.y=1", "-mat_mumps_cntl_1", "-1", "--output=o"])).unwrap();
+        let r =
+            split(&s(&["a.toml", "-ksp_type", "cg", "--check", "-ksp_view", "--set", "x.y=1", "-mat_mumps_cntl_1", "-1", "--output=o"]))
+                .unwrap();
         assert_eq!(r.ours, s(&["a.toml", "--check", "--set", "x.y=1", "--output=o"]));
         assert_eq!(r.petsc, s(&["-ksp_type", "cg", "-ksp_view", "-mat_mumps_cntl_1", "-1"]));
     }

@@ -23,7 +23,12 @@ pub fn mesh_spec(scene: &Scene, half_z: bool) -> mesh::MeshSpec {
         cube_edge: scene.mesh.cube_size,
         depth: scene.mesh.cube_size,
         half_z,
-        contact: mesh::Rect { x0: scene.reynolds.x_min, x1: scene.reynolds.x_max, z0: scene.reynolds.z_min, z1: if half_z { 0.0 } else { scene.reynolds.z_max } },
+        contact: mesh::Rect {
+            x0: scene.reynolds.x_min,
+            x1: scene.reynolds.x_max,
+            z0: scene.reynolds.z_min,
+            z1: if half_z { 0.0 } else { scene.reynolds.z_max },
+        },
         contact_size: scene.mesh.contact_size,
         growth: scene.mesh.growth,
         core: (scene.mesh.core_size > 0.0).then(|| {
@@ -40,7 +45,8 @@ pub fn mesh_spec(scene: &Scene, half_z: bool) -> mesh::MeshSpec {
             let m = &scene.mesh;
             (mesh::Rect { x0: m.patch_x_min, x1: m.patch_x_max, z0: m.patch_z_min, z1: m.patch_z_max }, m.patch_size)
         }),
-        patch_radii: (scene.mesh.patch_size > 0.0 && scene.mesh.patch_r_max > 0.0).then_some((scene.mesh.patch_r_min, scene.mesh.patch_r_max)),
+        patch_radii: (scene.mesh.patch_size > 0.0 && scene.mesh.patch_r_max > 0.0)
+            .then_some((scene.mesh.patch_r_min, scene.mesh.patch_r_max)),
         size_field: None,
     }
 }
@@ -51,7 +57,11 @@ pub fn contact_uy(mesh: &Mesh, dofs: &DofMap, sol: &[f64], x: f64, z: f64) -> Re
     let nodes = mesh.contact_tris[tri];
     let vals = nodes.map(|n| {
         let d = dofs.node_dof[n as usize][1];
-        if d < 0 { 0.0 } else { sol[d as usize] }
+        if d < 0 {
+            0.0
+        } else {
+            sol[d as usize]
+        }
     });
     Ok(crate::fem::p2_tri_eval(&vals, bary))
 }
@@ -62,7 +72,16 @@ pub fn contact_uy(mesh: &Mesh, dofs: &DofMap, sol: &[f64], x: f64, z: f64) -> Re
 /// main solve is reused (one more right-hand side); otherwise rank 0 solves the disc's own
 /// elastic problem. Collective; the JSON object is returned on rank 0.
 #[allow(clippy::too_many_arguments)]
-fn subsurface_stresses(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &mesh::Partition, dofs: &DofMap, ksp: &Ksp, main_solve_s: f64, dir: &std::path::Path) -> Result<Option<serde_json::Value>, String> {
+fn subsurface_stresses(
+    ctx: &Context,
+    scene: &Scene,
+    mesh: &Mesh,
+    part: &mesh::Partition,
+    dofs: &DofMap,
+    ksp: &Ksp,
+    main_solve_s: f64,
+    dir: &std::path::Path,
+) -> Result<Option<serde_json::Value>, String> {
     use super::subsurface as sub;
     let pe = |e: petsc::PetscError| e.to_string();
     let t0 = Instant::now();
@@ -87,7 +106,12 @@ fn subsurface_stresses(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &mesh::P
         let x = Vector::new(comm, dofs.local(ctx.rank)).map_err(pe)?;
         ksp.solve(&b, &x).map_err(pe)?;
         let sol = x.gather_all().map_err(pe)?;
-        let cost = sub::SolveCost { seconds: t0.elapsed().as_secs_f64(), rss_increase_mb: sub::current_rss_mb() - rss0, factor_mb: ksp.mumps_factor_mb(), unknowns: dofs.total() };
+        let cost = sub::SolveCost {
+            seconds: t0.elapsed().as_secs_f64(),
+            rss_increase_mb: sub::current_rss_mb() - rss0,
+            factor_mb: ksp.mumps_factor_mb(),
+            unknowns: dofs.total(),
+        };
         (Some(sub::node_displacements(dofs, &sol, 1.0)), cost)
     } else if ctx.rank == 0 {
         let (mut u, c) = sub::solve_alone(mesh, disc.nu, &[&load])?;
@@ -142,13 +166,20 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     crate::interrupt::check("the mesh")?;
     ctx.log(format!(
         "mesh: {} P2 tetrahedra, {} nodes, {} contact triangles, h_c = {} a, {} displacement unknowns, worst dihedral {:.1} deg",
-        mesh.tets.len(), mesh.nodes.len(), mesh.contact_tris.len(), mesh.contact_size, dofs.total(), quality.min_dihedral_deg
+        mesh.tets.len(),
+        mesh.nodes.len(),
+        mesh.contact_tris.len(),
+        mesh.contact_size,
+        dofs.total(),
+        quality.min_dihedral_deg
     ));
 
     let t1 = Instant::now();
     let k = assembly::assemble_stiffness(comm, &mesh, &part, &dofs, ctx.rank, eq.nu).map_err(pe)?;
     let factor = assembly::traction_factor(eq.nu);
-    let b = assembly::assemble_pressure_load(comm, &mesh, &part, &dofs, ctx.rank, factor, &|v| hertz_load::hertz_p2_load(v, HERTZ_SPLIT_DEPTH)).map_err(pe)?;
+    let b =
+        assembly::assemble_pressure_load(comm, &mesh, &part, &dofs, ctx.rank, factor, &|v| hertz_load::hertz_p2_load(v, HERTZ_SPLIT_DEPTH))
+            .map_err(pe)?;
     let assembly_s = t1.elapsed().as_secs_f64();
     crate::interrupt::check("the assembly")?;
     // Load check: the assembled traction sums to -factor * integral of P = -factor * 2 pi / 3.
@@ -158,7 +189,12 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     };
     let load_exact = -factor * 2.0 * std::f64::consts::PI / 3.0;
     let load_error_rel = (load_num - load_exact).abs() / load_exact.abs();
-    ctx.log(format!("assembly: {:.2} s, {:.0} non-zeros; traction load error {:.2e}", assembly_s, k.nonzeros().map_err(pe)?, load_error_rel));
+    ctx.log(format!(
+        "assembly: {:.2} s, {:.0} non-zeros; traction load error {:.2e}",
+        assembly_s,
+        k.nonzeros().map_err(pe)?,
+        load_error_rel
+    ));
 
     let t2 = Instant::now();
     petsc::ksp::set_direct_solver_defaults("").map_err(pe)?;
@@ -173,15 +209,13 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     let scale = hertz.a * hertz.a / scene.geometry.ball_radius; // U -> metres
     let u_c = contact_uy(&mesh, &dofs, &sol, 0.0, 0.0)?;
     let u_a = contact_uy(&mesh, &dofs, &sol, 1.0, 0.0)?;
-    ctx.log(format!(
-        "deflection: U(0) = {:.5} (half-space -1), U(0) - U(a) = {:.5} (half-space -0.5)",
-        u_c, u_c - u_a
-    ));
+    ctx.log(format!("deflection: U(0) = {:.5} (half-space -1), U(0) - U(a) = {:.5} (half-space -0.5)", u_c, u_c - u_a));
     let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
     let peak_total = collective::sum_f64(&ctx.world, crate::output::peak_rss_mb());
     let total_s = ctx.start.elapsed().as_secs_f64();
     ctx.write_results(|dir| {
-        let subsurface = if scene.output.subsurface { Some(subsurface_stresses(ctx, scene, &mesh, &part, &dofs, &ksp, solve_s, dir)?) } else { None };
+        let subsurface =
+            if scene.output.subsurface { Some(subsurface_stresses(ctx, scene, &mesh, &part, &dofs, &ksp, solve_s, dir)?) } else { None };
         if ctx.rank != 0 {
             return Ok(());
         }

@@ -33,7 +33,11 @@ impl Setup {
 
     /// As [`Setup::new`], the contact face refined to `field` as well (adaptive
     /// refinement; elastic solids only).
-    pub fn with_size_field(ctx: &Context, scene: &Scene, field: Option<std::sync::Arc<crate::mesh::size_field::SizeField>>) -> Result<Setup, String> {
+    pub fn with_size_field(
+        ctx: &Context,
+        scene: &Scene,
+        field: Option<std::sync::Arc<crate::mesh::size_field::SizeField>>,
+    ) -> Result<Setup, String> {
         let t0 = Instant::now();
         let half = scene.uses_half_domain();
         if half {
@@ -58,7 +62,13 @@ impl Setup {
         let (n_u, n_p) = layout.counts();
         ctx.log(format!(
             "mesh: {} P2 tetrahedra, {} nodes, h_c = {} a, {} contact triangles; unknowns: {} elastic + {} pressure + h0 = {}",
-            mesh.tets.len(), mesh.nodes.len(), mesh.contact_size, mesh.contact_tris.len(), n_u, n_p, layout.total()
+            mesh.tets.len(),
+            mesh.nodes.len(),
+            mesh.contact_size,
+            mesh.contact_tris.len(),
+            n_u,
+            n_p,
+            layout.total()
         ));
         Ok(Setup { mesh, part, dofs, layout, half, mesh_s: t0.elapsed().as_secs_f64(), worst_quality: quality.min_dihedral_deg })
     }
@@ -82,10 +92,12 @@ pub struct PointResult {
 pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
     use crate::case::{CavitationModel, DensityModel, KinematicsModel, ViscosityModel};
     let e = &scene.effects;
-    let mut simulated = vec![format!("Reynolds equation (P2, {} stabilisation) with the load balance for h0", scene.reynolds.stabilisation)];
+    let mut simulated =
+        vec![format!("Reynolds equation (P2, {} stabilisation) with the load balance for h0", scene.reynolds.stabilisation)];
     let mut skipped = Vec::new();
     match e.elasticity {
-        crate::case::ElasticityModel::Elastic => simulated.push("elastic deformation: P2 equivalent cube (reynolds.coupling: condensed onto the contact face or monolithic)".into()),
+        crate::case::ElasticityModel::Elastic => simulated
+            .push("elastic deformation: P2 equivalent cube (reynolds.coupling: condensed onto the contact face or monolithic)".into()),
         crate::case::ElasticityModel::Rigid => skipped.push("elastic deformation and the 3D mesh (effects.elasticity = \"rigid\")".into()),
     }
     simulated.push(match e.viscosity {
@@ -101,7 +113,9 @@ pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
         DensityModel::Incompressible => skipped.push("compressibility (effects.density = \"incompressible\")".into()),
     }
     match e.kinematics {
-        KinematicsModel::Spin => simulated.push("spin kinematics: non-uniform entrainment (Um(z), Wm(x)) from the ball and disc rotations".into()),
+        KinematicsModel::Spin => {
+            simulated.push("spin kinematics: non-uniform entrainment (Um(z), Wm(x)) from the ball and disc rotations".into())
+        }
         KinematicsModel::Uniform => skipped.push("spin (effects.kinematics = \"uniform\": U_B = U_BO, U_D = U_DO, W = 0)".into()),
     }
     match e.cavitation {
@@ -128,7 +142,11 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let hertz = scene.hertz();
     ctx.log(format!("Hertz: a = {:.5e} m, p_H = {:.5e} Pa; lambda_bar = {:.4e}", hertz.a, hertz.ph, driver::lambda_bar(scene)));
     if let Some(zc) = scene.spin_pole_over_a() {
-        let inside = if zc.abs() < 1.0 { ": inside the Hertz circle, so the lubricant circulates on closed streamlines in the contact (the hardest spin regime)" } else { "" };
+        let inside = if zc.abs() < 1.0 {
+            ": inside the Hertz circle, so the lubricant circulates on closed streamlines in the contact (the hardest spin regime)"
+        } else {
+            ""
+        };
         ctx.log(format!("spin: the mean surface velocity turns about (0, {zc:.3}a){inside}"));
     }
     if scene.accuracy.target > 0.0 {
@@ -137,7 +155,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let setup = Setup::new(ctx, scene)?;
     crate::interrupt::check("the mesh")?;
     let report = effects_report(scene, setup.half);
-    ctx.log(format!("simulated: {}", report["simulated"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
+    ctx.log(format!(
+        "simulated: {}",
+        report["simulated"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")
+    ));
     ctx.log(format!("skipped: {}", report["skipped"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
     let solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
     if scene.is_sweep() {
@@ -162,14 +183,30 @@ pub fn friction_setup<'a>(scene: &Scene, eta: &'a dyn Fn(f64) -> f64, rect: crat
         FrictionModel::ReeEyring => ShearLaw::ReeEyring { tau0: scene.lubricant.as_ref()?.ree_eyring_stress },
     };
     let (hertz, scales) = (scene.hertz(), scene.scales());
-    Some(FrictionSetup { law, eta, kinematics: scene.kinematics()?, a: hertz.a, ph: hertz.ph, hs: scales.film_scale(), rect, load: scene.operating.load })
+    Some(FrictionSetup {
+        law,
+        eta,
+        kinematics: scene.kinematics()?,
+        a: hertz.a,
+        ph: hertz.ph,
+        hs: scales.film_scale(),
+        rect,
+        load: scene.operating.load,
+    })
 }
 
 /// Post-processing of one converged point: film statistics and log line on every rank; on
 /// rank 0 the friction pass and every output file in `dir` (profiles, plots, VTU,
 /// summary.json last). Returns the point's numbers (rank 0; the others return the film
 /// numbers without friction). Not collective except for the peak-memory reduction.
-pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution, condensation_s: Option<f64>, dir: &Path) -> Result<PointResult, String> {
+pub fn post_point(
+    ctx: &Context,
+    scene: &Scene,
+    setup: &Setup,
+    sol: &EhlSolution,
+    condensation_s: Option<f64>,
+    dir: &Path,
+) -> Result<PointResult, String> {
     let t_post = Instant::now();
     let (mesh, layout) = (&setup.mesh, &setup.layout);
     let hertz = scene.hertz();
@@ -183,16 +220,25 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
         return Err("the converged state contains NaN or infinite values; no result written".into());
     }
     if st.hm <= 0.0 {
-        return Err(format!("the converged film is not positive everywhere (minimum H = {:.3e} at ({:.3}a, {:.3}a)); no result written", st.hm, st.hm_at[0], st.hm_at[1]));
+        return Err(format!(
+            "the converged film is not positive everywhere (minimum H = {:.3e} at ({:.3}a, {:.3}a)); no result written",
+            st.hm, st.hm_at[0], st.hm_at[1]
+        ));
     }
     let hs = scene.scales().film_scale();
     let (a, ph) = (hertz.a, hertz.ph);
     ctx.log(format!(
         "result: hc = {:.4e} m, hm = {:.4e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa, load error {:.2e}",
-        st.hc * hs, st.hm * hs, st.hm_at[0], st.hm_at[1], st.pmax * ph, load_error
+        st.hc * hs,
+        st.hm * hs,
+        st.hm_at[0],
+        st.hm_at[1],
+        st.pmax * ph,
+        load_error
     ));
     let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
-    let mut res = PointResult { hc: st.hc * hs, hm: st.hm * hs, pmax: st.pmax * ph, load_error, fx: None, fz: None, profile_x0: Vec::new() };
+    let mut res =
+        PointResult { hc: st.hc * hs, hm: st.hm * hs, pmax: st.pmax * ph, load_error, fx: None, fz: None, profile_x0: Vec::new() };
     if ctx.rank != 0 {
         return Ok(res);
     }
@@ -203,7 +249,10 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
     let friction = match &fset {
         Some(fs) => {
             let f = friction_pass(&fields, fs)?;
-            ctx.log(format!("friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s)", scene.effects.friction, f.fx, f.fz, f.fx_n, f.fz_n, f.tau_max, f.seconds));
+            ctx.log(format!(
+                "friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s)",
+                scene.effects.friction, f.fx, f.fz, f.fx_n, f.fz_n, f.tau_max, f.seconds
+            ));
             res.fx = Some(f.fx);
             res.fz = Some(f.fz);
             Some(f)
@@ -253,10 +302,15 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
     if scene.output.vtu {
         write_face_vtu(dir, &fields, a, ph, hs, friction.as_ref())?;
     }
-    let subsurface = if scene.output.subsurface { Some(subsurface_point(ctx, scene, setup, &fields, friction.as_ref(), sol, condensation_s, dir)?) } else { None };
+    let subsurface = if scene.output.subsurface {
+        Some(subsurface_point(ctx, scene, setup, &fields, friction.as_ref(), sol, condensation_s, dir)?)
+    } else {
+        None
+    };
     // The nodal pressure a later run can start from (--start-from).
     let face_p = dir.join(super::restart::FACE_PRESSURE);
-    crate::output::write_atomic(&face_p, super::restart::face_pressure_csv(mesh, &|n| fields.p_node(n), a, ph).as_bytes()).map_err(|e| format!("cannot write {}: {e}", face_p.display()))?;
+    crate::output::write_atomic(&face_p, super::restart::face_pressure_csv(mesh, &|n| fields.p_node(n), a, ph).as_bytes())
+        .map_err(|e| format!("cannot write {}: {e}", face_p.display()))?;
     let hd = scene.hamrock_dowson();
     let (n_u, n_p) = layout.counts();
     let kin = scene.kinematics().expect("lubricated scene");
@@ -266,7 +320,12 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
         ranks: ctx.size,
         converged: sol.report.converged,
         hertz: HertzSummary { a_m: a, ph_pa: ph, e_prime_pa: hertz.e_prime },
-        operating: OperatingSummary { load_n: scene.operating.load, entrainment_speed_m_s: scene.operating.entrainment_speed, slide_to_roll: scene.operating.slide_to_roll, tilt_angle_deg: scene.operating.tilt_angle },
+        operating: OperatingSummary {
+            load_n: scene.operating.load,
+            entrainment_speed_m_s: scene.operating.entrainment_speed,
+            slide_to_roll: scene.operating.slide_to_roll,
+            tilt_angle_deg: scene.operating.tilt_angle,
+        },
         kinematics: KinematicsSummary {
             model: scene.effects.kinematics.as_str().to_string(),
             omega_b_rad_s: kin.omega_b,
@@ -294,7 +353,14 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
             hc_hamrock_dowson_m: hd.map(|h| h.central_film_thickness()),
             hm_hamrock_dowson_m: hd.map(|h| h.minimum_film_thickness()),
         },
-        pressure: PressureSummary { pmax_pa: st.pmax * ph, pmax_x_m: st.pmax_at[0] * a, pmax_z_m: st.pmax_at[1] * a, pmin_pa: st.pmin * ph, pmin_nodes_pa: st.pmin_nodes * ph, load_error_rel: load_error },
+        pressure: PressureSummary {
+            pmax_pa: st.pmax * ph,
+            pmax_x_m: st.pmax_at[0] * a,
+            pmax_z_m: st.pmax_at[1] * a,
+            pmin_pa: st.pmin * ph,
+            pmin_nodes_pa: st.pmin_nodes * ph,
+            load_error_rel: load_error,
+        },
         moes: scene.moes().map(|m| MoesSummary { m: m.m, l: m.l }),
         solver: SolverSummary {
             newton_iterations: sol.newton_total,
@@ -321,7 +387,14 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
         peak_rss_mb: peak,
         effects: effects_report(scene, setup.half),
         scene: scene.clone(),
-        friction: friction.as_ref().map(|f| FrictionSummary { model: scene.effects.friction.as_str().to_string(), fx: f.fx, fz: f.fz, fx_n: f.fx_n, fz_n: f.fz_n, tau_max_pa: f.tau_max }),
+        friction: friction.as_ref().map(|f| FrictionSummary {
+            model: scene.effects.friction.as_str().to_string(),
+            fx: f.fx,
+            fz: f.fz,
+            fx_n: f.fx_n,
+            fz_n: f.fz_n,
+            tau_max_pa: f.tau_max,
+        }),
     };
     let mut summary = to_json(&summary)?;
     if let Some(s) = subsurface {
@@ -338,7 +411,16 @@ pub fn post_point(ctx: &Context, scene: &Scene, setup: &Setup, sol: &EhlSolution
 /// stresses on the disc; one MUMPS Cholesky on rank 0 (the condensed Newton keeps no 3D
 /// displacement). Returns the `subsurface` object of summary.json.
 #[allow(clippy::too_many_arguments)]
-fn subsurface_point(ctx: &Context, scene: &Scene, setup: &Setup, fields: &FieldsOnFace, friction: Option<&FrictionResult>, sol: &EhlSolution, condensation_s: Option<f64>, dir: &Path) -> Result<serde_json::Value, String> {
+fn subsurface_point(
+    ctx: &Context,
+    scene: &Scene,
+    setup: &Setup,
+    fields: &FieldsOnFace,
+    friction: Option<&FrictionResult>,
+    sol: &EhlSolution,
+    condensation_s: Option<f64>,
+    dir: &Path,
+) -> Result<serde_json::Value, String> {
     use super::subsurface as sub;
     let t0 = Instant::now();
     let mesh = &setup.mesh;
@@ -373,13 +455,22 @@ fn subsurface_point(ctx: &Context, scene: &Scene, setup: &Setup, fields: &Fields
     let loads: Vec<&sub::FaceLoad> = if with_friction { vec![&load, &pressure_only] } else { vec![&load] };
     let (us, cost) = sub::solve_alone(mesh, disc.nu, &loads)?;
     let u = &us[0];
-    let traction = if with_friction { format!("EHL pressure and the {} shear stresses on the disc", scene.effects.friction) } else { "EHL pressure".to_string() };
+    let traction = if with_friction {
+        format!("EHL pressure and the {} shear stresses on the disc", scene.effects.friction)
+    } else {
+        "EHL pressure".to_string()
+    };
     let params = sub::Params {
         nu: disc.nu,
         e: disc.e,
         a: hertz.a,
         ph: hertz.ph,
-        rect: crate::mesh::Rect { x0: scene.reynolds.x_min, x1: scene.reynolds.x_max, z0: scene.reynolds.z_min, z1: if setup.half { 0.0 } else { scene.reynolds.z_max } },
+        rect: crate::mesh::Rect {
+            x0: scene.reynolds.x_min,
+            x1: scene.reynolds.x_max,
+            z0: scene.reynolds.z_min,
+            z1: if setup.half { 0.0 } else { scene.reynolds.z_max },
+        },
         half: setup.half,
         png: scene.output.png,
         vtu: scene.output.vtu,
@@ -398,7 +489,13 @@ fn subsurface_point(ctx: &Context, scene: &Scene, setup: &Setup, fields: &Fields
         "ehl_solve_s": sol.solve_s, "condensation_s": condensation_s,
     });
     obj["total_s"] = json!(t0.elapsed().as_secs_f64());
-    ctx.log(format!("subsurface: {:.2} s (elastic solve {:.2} s, MUMPS factor {:.0} MB; the EHL solve took {:.2} s)", t0.elapsed().as_secs_f64(), cost.seconds, cost.factor_mb.unwrap_or(f64::NAN), sol.solve_s));
+    ctx.log(format!(
+        "subsurface: {:.2} s (elastic solve {:.2} s, MUMPS factor {:.0} MB; the EHL solve took {:.2} s)",
+        t0.elapsed().as_secs_f64(),
+        cost.seconds,
+        cost.factor_mb.unwrap_or(f64::NAN),
+        sol.solve_s
+    ));
     Ok(obj)
 }
 
@@ -414,7 +511,15 @@ fn write_profiles(dir: &Path, name: &str, rows: &[Vec<f64>], with_tau: bool) -> 
 
 /// PNG maps of p and h on the Reynolds rectangle and PNG plots of the two centre-line
 /// profiles (rank 0). Each P2 triangle is drawn as its 4 linear sub-triangles.
-fn write_plots(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, prof_x0: &[Vec<f64>], prof_z0: &[Vec<f64>]) -> Result<(), String> {
+fn write_plots(
+    dir: &Path,
+    fields: &FieldsOnFace,
+    a: f64,
+    ph: f64,
+    hs: f64,
+    prof_x0: &[Vec<f64>],
+    prof_z0: &[Vec<f64>],
+) -> Result<(), String> {
     let mesh = fields.mesh;
     use crate::output::plot::{line_plot, map_plot, LineOpts, MapOpts, Series, Style};
     let mut tris = Vec::new();
@@ -444,7 +549,12 @@ fn write_plots(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, prof
     // The film grows to tens of um at the rectangle's corners: colours and the profile's
     // film axis stop at 4 hc so the contact's film shape stays visible.
     let h_top = 4.0 * fields.stats().hc * hs * 1e6;
-    let opts = |label: &str, range: Option<(f64, f64)>| MapOpts { circle: Some((0.0, 0.0, 1.0)), colorbar_label: label.to_string(), range, ..MapOpts::default() };
+    let opts = |label: &str, range: Option<(f64, f64)>| MapOpts {
+        circle: Some((0.0, 0.0, 1.0)),
+        colorbar_label: label.to_string(),
+        range,
+        ..MapOpts::default()
+    };
     for (name, title, vals, label, range) in [
         ("pressure_map.png", "pressure", &pv, "p (GPa)", None),
         ("film_map.png", "film thickness (colours saturate at 4 hc)", &hv, "h (um)", Some((0.0, h_top))),
@@ -454,9 +564,15 @@ fn write_plots(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, prof
     }
     // The contact itself: |x|, |z| <= 1.3 a, colours up to 1.5 hc, so the side lobes, the
     // outlet constriction and the minimum film stand out.
-    let zoom = MapOpts { x_range: Some((-1.3, 1.3)), y_range: Some((-1.3, 1.3)), ..opts("h (um)", Some((0.0, 1.5 * fields.stats().hc * hs * 1e6))) };
+    let zoom = MapOpts {
+        x_range: Some((-1.3, 1.3)),
+        y_range: Some((-1.3, 1.3)),
+        ..opts("h (um)", Some((0.0, 1.5 * fields.stats().hc * hs * 1e6)))
+    };
     let path = dir.join("film_map_contact.png");
-    crate::output::write_atomic_with(&path, |t| map_plot(t, "film thickness in the contact (colours saturate at 1.5 hc)", "x / a", "z / a", &tris, &hv, &zoom))?;
+    crate::output::write_atomic_with(&path, |t| {
+        map_plot(t, "film thickness in the contact (colours saturate at 1.5 hc)", "x / a", "z / a", &tris, &hv, &zoom)
+    })?;
     for (name, title, rows, col, xl) in [
         ("profile_z0.png", "centre line z = 0 (rolling direction)", prof_z0, 0usize, "x / a"),
         ("profile_x0.png", "centre line x = 0 (transverse)", prof_x0, 1usize, "z / a"),
@@ -507,12 +623,18 @@ fn write_face_vtu(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, f
     }
     let conn: Vec<u32> = mesh.contact_tris.iter().flat_map(|t| t.map(|n| id[n as usize])).collect();
     use crate::output::vtu::{write_vtu_single_type, Field};
-    let mut vtu_fields = vec![Field { name: "p_pa", components: 1, values: &p }, Field { name: "h_m", components: 1, values: &h }, Field { name: "u2_m", components: 1, values: &u2 }];
+    let mut vtu_fields = vec![
+        Field { name: "p_pa", components: 1, values: &p },
+        Field { name: "h_m", components: 1, values: &h },
+        Field { name: "u2_m", components: 1, values: &u2 },
+    ];
     if friction.is_some() {
         vtu_fields.push(Field { name: "tau_disc_pa", components: 3, values: &tau });
     }
     let path = dir.join("contact_face.vtu");
-    crate::output::write_atomic_with(&path, |t| write_vtu_single_type(t, &points, 22, &conn, &vtu_fields, &[]).map_err(|e| format!("cannot write {}: {e}", t.display())))
+    crate::output::write_atomic_with(&path, |t| {
+        write_vtu_single_type(t, &points, 22, &conn, &vtu_fields, &[]).map_err(|e| format!("cannot write {}: {e}", t.display()))
+    })
 }
 
 /// The friction pass reads the EHL solution through [`FaceSolution`] (so `friction` does

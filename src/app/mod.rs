@@ -10,9 +10,9 @@ pub mod study;
 pub mod subsurface;
 pub mod sweep;
 
+use crate::case::Scene;
 pub use crate::collective;
 pub use crate::context::Context;
-use crate::case::Scene;
 use crate::petsc::Petsc;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
@@ -112,7 +112,9 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {
-        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => study::run(&ctx, &scene, n, opts.ladder, first_size, opts.study_sequence),
+        Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => {
+            study::run(&ctx, &scene, n, opts.ladder, first_size, opts.study_sequence)
+        }
         Some(_) => Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into()),
         None => simulate(&ctx, &scene, earlier.as_ref()),
     };
@@ -208,8 +210,13 @@ fn checked_inputs(opts: &RunOptions) -> Result<(Scene, f64, Option<restart::Earl
     let earlier = match &opts.start_from {
         None => None,
         Some(_) if opts.study_levels.is_some() => return Err("--start-from applies to one solve, not to a --convergence-study".into()),
-        Some(_) if scene.is_sweep() => return Err("--start-from applies to one operating point: the scene has a [sweep] (each sweep point already starts from the previous one)".into()),
-        Some(_) if scene.effects.lubrication != crate::case::LubricationModel::Reynolds => return Err("--start-from needs a lubricated scene (effects.lubrication = \"reynolds\")".into()),
+        Some(_) if scene.is_sweep() => return Err(
+            "--start-from applies to one operating point: the scene has a [sweep] (each sweep point already starts from the previous one)"
+                .into(),
+        ),
+        Some(_) if scene.effects.lubrication != crate::case::LubricationModel::Reynolds => {
+            return Err("--start-from needs a lubricated scene (effects.lubrication = \"reynolds\")".into())
+        }
         Some(dir) => Some(restart::EarlierRun::read(dir)?),
     };
     Ok((scene, first_size, earlier))
@@ -238,7 +245,9 @@ pub fn check_mesh(scene: &Scene) -> Result<(), String> {
             ));
         }
     }
-    if scene.effects.elasticity == crate::case::ElasticityModel::Rigid && scene.effects.lubrication == crate::case::LubricationModel::Reynolds {
+    if scene.effects.elasticity == crate::case::ElasticityModel::Rigid
+        && scene.effects.lubrication == crate::case::LubricationModel::Reynolds
+    {
         return Ok(());
     }
     spec.validate().map(|_| ()).map_err(|e| format!("the mesh of [mesh] and [reynolds] cannot be built ({}); check mesh.cube_size, mesh.contact_size and the reynolds.x_min/x_max/z_min/z_max rectangle", e.trim_start_matches("mesh spec: ")))

@@ -44,11 +44,17 @@ impl EarlierRun {
     pub fn read(dir: &Path) -> Result<EarlierRun, String> {
         let err = |what: String| format!("--start-from {}: {what}", dir.display());
         let summary_path = dir.join("summary.json");
-        let text = crate::case::read_bounded(&summary_path, 16 << 20).map_err(|e| err(format!("cannot read {}: {e} (the folder of a converged lubricated run is expected)", summary_path.display())))?;
+        let text = crate::case::read_bounded(&summary_path, 16 << 20).map_err(|e| {
+            err(format!("cannot read {}: {e} (the folder of a converged lubricated run is expected)", summary_path.display()))
+        })?;
         let summary = match Summary::from_json(&text) {
             Ok(s) => s,
-            Err(_) if serde_json::from_str::<DrySummary>(&text).is_ok() => return Err(err("the earlier run is a dry (Hertz) run: it has no film to start from".into())),
-            Err(e) => return Err(err(format!("{} is not the summary of a lubricated run this version can read: {e}", summary_path.display()))),
+            Err(_) if serde_json::from_str::<DrySummary>(&text).is_ok() => {
+                return Err(err("the earlier run is a dry (Hertz) run: it has no film to start from".into()))
+            }
+            Err(e) => {
+                return Err(err(format!("{} is not the summary of a lubricated run this version can read: {e}", summary_path.display())))
+            }
         };
         if !summary.converged {
             return Err(err(format!("{} is not the summary of a converged run (\"converged\" is not true)", summary_path.display())));
@@ -81,7 +87,11 @@ impl EarlierRun {
         }
         let mut p_pa = vec![0.0; mesh.nodes.len()];
         for (k, (row, &n)) in rows.iter().zip(&mesh.contact_nodes).enumerate() {
-            let v: Vec<f64> = row.split(',').map(|w| w.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|e| err(format!("{} line {}: {e}", csv_path.display(), k + 2)))?;
+            let v: Vec<f64> = row
+                .split(',')
+                .map(|w| w.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|e| err(format!("{} line {}: {e}", csv_path.display(), k + 2)))?;
             if v.len() != 3 || !v.iter().all(|x| x.is_finite()) {
                 return Err(err(format!("{} line {}: expected three finite numbers x_m,z_m,p_pa", csv_path.display(), k + 2)));
             }
@@ -105,7 +115,12 @@ impl EarlierRun {
 
     /// Newton from this run's pressure for `scene` (whose scales may differ from the
     /// earlier scene's), falling back to the Hertz start. Collective.
-    pub fn solve(&self, ctx: &super::Context, scene: &Scene, solver: &crate::ehl::driver::EhlSolver) -> Result<crate::ehl::driver::EhlSolution, String> {
+    pub fn solve(
+        &self,
+        ctx: &super::Context,
+        scene: &Scene,
+        solver: &crate::ehl::driver::EhlSolver,
+    ) -> Result<crate::ehl::driver::EhlSolution, String> {
         let hertz = scene.hertz();
         let (a, ph) = (hertz.a, hertz.ph);
         let p = |x: f64, z: f64| self.pressure_at(x * a, z * a) / ph;

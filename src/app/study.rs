@@ -75,7 +75,10 @@ pub fn check_ladder(ladder: Ladder, first: f64, levels: usize) -> Result<(), Str
         Ladder::Ring => crate::case::MIN_CONTACT_SIZE / 2.0,
     };
     if !(first.is_finite() && first > 0.0 && crate::mesh::spec::dyadic_size(first) == first && first <= 16.0) {
-        return Err(format!("--first-size {first}: the first level's {} size must be 16/2^k a (0.5, 0.25, 0.125, ...), at most 16", ladder.sized()));
+        return Err(format!(
+            "--first-size {first}: the first level's {} size must be 16/2^k a (0.5, 0.25, 0.125, ...), at most 16",
+            ladder.sized()
+        ));
     }
     let finest = level_size(first, levels.max(1) - 1);
     if levels < 2 || finest < min * (1.0 - 1e-12) {
@@ -209,7 +212,20 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
         .and_then(|sol| collective::agree(&ctx.world, post_point(ctx, &sc, &setup, &sol, solver.condensation_s, &dir)).map(|r| (sol, r)));
         let rss_mb = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
         let level = match solved {
-            Ok((sol, r)) => Level { failed: None, h, n_u, n_p, its: sol.newton_total, mesh_s: setup.mesh_s, setup_s: solver.condensation_s.unwrap_or(sol.assembly_s), coupling: solver.coupling().name(), newton_s: sol.solve_s, total_s: t0.elapsed().as_secs_f64(), rss_mb, r },
+            Ok((sol, r)) => Level {
+                failed: None,
+                h,
+                n_u,
+                n_p,
+                its: sol.newton_total,
+                mesh_s: setup.mesh_s,
+                setup_s: solver.condensation_s.unwrap_or(sol.assembly_s),
+                coupling: solver.coupling().name(),
+                newton_s: sol.solve_s,
+                total_s: t0.elapsed().as_secs_f64(),
+                rss_mb,
+                r,
+            },
             Err(e) => {
                 // A level too coarse for the load fails honestly: recorded, skipped, the
                 // ladder goes on.
@@ -220,7 +236,20 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
                 if crate::interrupt::agreed() != 0 {
                     return Err(e);
                 }
-                Level { failed: Some(e), h, n_u, n_p, its: 0, mesh_s: setup.mesh_s, setup_s: solver.condensation_s.unwrap_or(0.0), coupling: solver.coupling().name(), newton_s: 0.0, total_s: t0.elapsed().as_secs_f64(), rss_mb, r: PointResult::default() }
+                Level {
+                    failed: Some(e),
+                    h,
+                    n_u,
+                    n_p,
+                    its: 0,
+                    mesh_s: setup.mesh_s,
+                    setup_s: solver.condensation_s.unwrap_or(0.0),
+                    coupling: solver.coupling().name(),
+                    newton_s: 0.0,
+                    total_s: t0.elapsed().as_secs_f64(),
+                    rss_mb,
+                    r: PointResult::default(),
+                }
             }
         };
         if level.failed.is_none() {
@@ -241,7 +270,8 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
 fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) -> Result<(), String> {
     // Failed levels are listed, then left out of the estimates (the ladder still halves h
     // between the converged levels, which follow each other).
-    let failed: Vec<String> = all.iter().enumerate().filter_map(|(k, r)| r.failed.as_ref().map(|e| format!("level {} (h = {} a): {e}", k + 1, r.h))).collect();
+    let failed: Vec<String> =
+        all.iter().enumerate().filter_map(|(k, r)| r.failed.as_ref().map(|e| format!("level {} (h = {} a): {e}", k + 1, r.h))).collect();
     let rows: Vec<&Level> = all.iter().filter(|r| r.failed.is_none()).collect();
     let level_no = |r: &Level| all.iter().position(|q| std::ptr::eq(q, r)).unwrap() + 1;
     let friction = rows.iter().all(|r| r.r.fx.is_some());
@@ -255,16 +285,31 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) ->
         quantities.push(("fz", rows.iter().map(|r| r.r.fz.unwrap()).collect()));
     }
     // Reference: the Richardson estimate, or the finest level when there is none.
-    let refs: Vec<(f64, Option<f64>)> = quantities.iter().map(|(_, q)| richardson(q).map(|(v, p)| (v, Some(p))).unwrap_or((*q.last().unwrap(), None))).collect();
+    let refs: Vec<(f64, Option<f64>)> =
+        quantities.iter().map(|(_, q)| richardson(q).map(|(v, p)| (v, Some(p))).unwrap_or((*q.last().unwrap(), None))).collect();
     let err = |qi: usize, k: usize| (quantities[qi].1[k] - refs[qi].0).abs() / refs[qi].0.abs();
     // CSV
-    let mut csv = String::from("level,h_a,dofs_elastic,dofs_reynolds,coupling,newton_iterations,mesh_s,setup_s,newton_s,total_s,peak_rss_mb");
+    let mut csv =
+        String::from("level,h_a,dofs_elastic,dofs_reynolds,coupling,newton_iterations,mesh_s,setup_s,newton_s,total_s,peak_rss_mb");
     for (name, _) in &quantities {
         csv.push_str(&format!(",{name},{name}_rel_error"));
     }
     csv.push('\n');
     for (k, r) in rows.iter().enumerate() {
-        csv.push_str(&format!("{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.0}", level_no(r), r.h, r.n_u, r.n_p, r.coupling, r.its, r.mesh_s, r.setup_s, r.newton_s, r.total_s, r.rss_mb));
+        csv.push_str(&format!(
+            "{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.0}",
+            level_no(r),
+            r.h,
+            r.n_u,
+            r.n_p,
+            r.coupling,
+            r.its,
+            r.mesh_s,
+            r.setup_s,
+            r.newton_s,
+            r.total_s,
+            r.rss_mb
+        ));
         for (qi, (_, q)) in quantities.iter().enumerate() {
             csv.push_str(&format!(",{:e},{:e}", q[k], err(qi, k)));
         }
@@ -279,7 +324,20 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) ->
     }
     md.push_str(&format!("\n|{}\n", "---|".repeat(8 + 2 * quantities.len())));
     for (k, r) in rows.iter().enumerate() {
-        md.push_str(&format!("| {} | {} | {} | {} | {} | {} | {:.1} + {:.1} + {:.1} = {:.1} | {:.0} |", level_no(r), r.h, r.n_u, r.n_p, r.coupling, r.its, r.mesh_s, r.setup_s, r.newton_s, r.total_s, r.rss_mb));
+        md.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {:.1} + {:.1} + {:.1} = {:.1} | {:.0} |",
+            level_no(r),
+            r.h,
+            r.n_u,
+            r.n_p,
+            r.coupling,
+            r.its,
+            r.mesh_s,
+            r.setup_s,
+            r.newton_s,
+            r.total_s,
+            r.rss_mb
+        ));
         for (qi, (_, q)) in quantities.iter().enumerate() {
             md.push_str(&format!(" {:.5e} | {:.2} % |", q[k], 100.0 * err(qi, k)));
         }
@@ -295,7 +353,10 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) ->
     for (qi, (name, _)) in quantities.iter().enumerate() {
         match refs[qi].1 {
             Some(p) => md.push_str(&format!("- {name}: {:.5e} (Richardson, observed order {p:.2})\n", refs[qi].0)),
-            None if rows.len() < 3 => md.push_str(&format!("- {name}: {:.5e} = the finest level (fewer than three converged levels: no extrapolation)\n", refs[qi].0)),
+            None if rows.len() < 3 => md.push_str(&format!(
+                "- {name}: {:.5e} = the finest level (fewer than three converged levels: no extrapolation)\n",
+                refs[qi].0
+            )),
             None => {
                 let q = &quantities[qi].1;
                 let why = match convergence(q) {
@@ -316,11 +377,23 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) ->
     let judged = if extrapolated { rows.len() } else { rows.len() - 1 };
     // The time a level costs: its own, or with --sequence the ladder's up to it (a
     // sequenced level needs the levels before it).
-    let reach: Vec<f64> = rows.iter().scan(0.0, |sum, r| {
-        *sum = if sequence { *sum + r.total_s } else { r.total_s };
-        Some(*sum)
-    }).collect();
-    let within = |tol: f64| rows.iter().take(judged).enumerate().find(|(k, _)| err(0, *k) < tol && err(1, *k) < tol).map(|(k, r)| format!("level {} ({:.1} s{})", level_no(r), reach[k], if sequence { " including the levels before it" } else { "" })).unwrap_or_else(|| "no level".into());
+    let reach: Vec<f64> = rows
+        .iter()
+        .scan(0.0, |sum, r| {
+            *sum = if sequence { *sum + r.total_s } else { r.total_s };
+            Some(*sum)
+        })
+        .collect();
+    let within = |tol: f64| {
+        rows.iter()
+            .take(judged)
+            .enumerate()
+            .find(|(k, _)| err(0, *k) < tol && err(1, *k) < tol)
+            .map(|(k, r)| {
+                format!("level {} ({:.1} s{})", level_no(r), reach[k], if sequence { " including the levels before it" } else { "" })
+            })
+            .unwrap_or_else(|| "no level".into())
+    };
     md.push_str(&format!(
         "\nhc and hm within 1 % of the reference: {}; within 0.5 %: {}{}.\n",
         within(0.01),
@@ -349,7 +422,9 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) ->
             continue;
         }
         let lo = LineOpts { log_x: true, log_y: true, ..LineOpts::default() };
-        crate::output::write_atomic_with(&ctx.out_dir.join(name), |t| line_plot(t, &format!("{}: error against the reference", scene.name), xlabel, "relative error (%)", &series, &lo))?;
+        crate::output::write_atomic_with(&ctx.out_dir.join(name), |t| {
+            line_plot(t, &format!("{}: error against the reference", scene.name), xlabel, "relative error (%)", &series, &lo)
+        })?;
     }
     Ok(())
 }

@@ -17,9 +17,7 @@ use crate::output::vtu::{write_vtu_single_type, Field, VTK_QUADRATIC_TETRA};
 use crate::petsc::{self, ffi, Ksp, Vector};
 use crate::solid::assembly::{assemble_stiffness, tet_vertices};
 use crate::solid::dofmap::DofMap;
-use crate::solid::stress::{
-    eval_p2, principal, recover_nodal, recover_spr, tresca, von_mises, Sym,
-};
+use crate::solid::stress::{eval_p2, principal, recover_nodal, recover_spr, tresca, von_mises, Sym};
 use serde_json::json;
 use std::path::Path;
 use std::time::Instant;
@@ -68,10 +66,7 @@ pub fn assemble_face_traction(
 /// The per-node displacement `[u_x, u_y, u_z]` (0 on constrained components) of a gathered
 /// solution in the numbering `dofs`.
 pub fn node_displacements(dofs: &DofMap, sol: &[f64], scale: f64) -> Vec<[f64; 3]> {
-    dofs.node_dof
-        .iter()
-        .map(|d| d.map(|i| if i < 0 { 0.0 } else { scale * sol[i as usize] }))
-        .collect()
+    dofs.node_dof.iter().map(|d| d.map(|i| if i < 0 { 0.0 } else { scale * sol[i as usize] })).collect()
 }
 
 /// A displacement `[u_x, u_y, u_z]` per mesh node.
@@ -94,11 +89,7 @@ pub fn current_rss_mb() -> f64 {
     let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) } as f64;
     std::fs::read_to_string("/proc/self/statm")
         .ok()
-        .and_then(|s| {
-            s.split_whitespace()
-                .nth(1)
-                .and_then(|v| v.parse::<f64>().ok())
-        })
+        .and_then(|s| s.split_whitespace().nth(1).and_then(|v| v.parse::<f64>().ok()))
         .map(|pages| pages * page / 1048576.0)
         .unwrap_or(f64::NAN)
 }
@@ -109,11 +100,7 @@ pub const PREFIX: &str = "subsurface_";
 /// Solves the elastic problem of the disc (unit Young's modulus, Poisson ratio `nu`) under
 /// each face traction of `loads`, on this rank alone (one MUMPS Cholesky on
 /// PETSC_COMM_SELF, one back substitution per load). The cost covers the first load.
-pub fn solve_alone(
-    mesh: &Mesh,
-    nu: f64,
-    loads: &[&FaceLoad],
-) -> Result<(Vec<NodeField>, SolveCost), String> {
+pub fn solve_alone(mesh: &Mesh, nu: f64, loads: &[&FaceLoad]) -> Result<(Vec<NodeField>, SolveCost), String> {
     let pe = |e: petsc::PetscError| format!("subsurface elastic solve: {e}");
     let t0 = Instant::now();
     let rss0 = current_rss_mb();
@@ -124,8 +111,7 @@ pub fn solve_alone(
     unsafe { ffi::MatSetOption(k.raw(), ffi::MatOption_MAT_SPD, ffi::PetscBool_PETSC_TRUE) };
     petsc::options::set_default(&format!("-{PREFIX}ksp_type"), "preonly").map_err(pe)?;
     petsc::options::set_default(&format!("-{PREFIX}pc_type"), "cholesky").map_err(pe)?;
-    petsc::options::set_default(&format!("-{PREFIX}pc_factor_mat_solver_type"), "mumps")
-        .map_err(pe)?;
+    petsc::options::set_default(&format!("-{PREFIX}pc_factor_mat_solver_type"), "mumps").map_err(pe)?;
     petsc::options::set_default(&format!("-{PREFIX}mat_mumps_icntl_7"), "4").map_err(pe)?;
     let ksp = Ksp::with_prefix(selfc, &k, PREFIX).map_err(pe)?;
     let mut out = Vec::new();
@@ -142,11 +128,7 @@ pub fn solve_alone(
                 unknowns: dofs.total(),
             };
         }
-        out.push(node_displacements(
-            &dofs,
-            &x.local_values().map_err(pe)?,
-            1.0,
-        ));
+        out.push(node_displacements(&dofs, &x.local_values().map_err(pe)?, 1.0));
     }
     Ok((out, cost))
 }
@@ -192,23 +174,12 @@ pub struct Extremum {
 
 impl<'a> Recovered<'a> {
     /// Recovers the stresses of the region from the per-node displacement `u`.
-    pub fn new(
-        mesh: &'a Mesh,
-        u: &[[f64; 3]],
-        nu: f64,
-        rect: &Rect,
-        method: StressRecovery,
-    ) -> Recovered<'a> {
+    pub fn new(mesh: &'a Mesh, u: &[[f64; 3]], nu: f64, rect: &Rect, method: StressRecovery) -> Recovered<'a> {
         let tets: Vec<usize> = (0..mesh.tets.len())
             .filter(|&t| {
                 let v = mesh.tet_corners(t);
-                let c: [f64; 3] =
-                    std::array::from_fn(|k| v.iter().map(|p| p[k]).sum::<f64>() / 4.0);
-                c[0] >= rect.x0
-                    && c[0] <= rect.x1
-                    && c[2] >= rect.z0
-                    && c[2] <= rect.z1
-                    && -c[1] <= REGION_DEPTH
+                let c: [f64; 3] = std::array::from_fn(|k| v.iter().map(|p| p[k]).sum::<f64>() / 4.0);
+                c[0] >= rect.x0 && c[0] <= rect.x1 && c[2] >= rect.z0 && c[2] <= rect.z1 && -c[1] <= REGION_DEPTH
             })
             .collect();
         let mut wanted = vec![false; mesh.nodes.len()];
@@ -227,32 +198,10 @@ impl<'a> Recovered<'a> {
             out
         };
         let (nodal, evaluated) = match method {
-            StressRecovery::Spr => recover_spr(
-                &mesh.nodes,
-                mesh.n_vertices,
-                &mesh.tets,
-                &verts,
-                &ue,
-                &wanted,
-                lambda,
-                mu,
-            ),
-            StressRecovery::Average => recover_nodal(
-                mesh.nodes.len(),
-                &mesh.tets,
-                &verts,
-                &ue,
-                &wanted,
-                lambda,
-                mu,
-            ),
+            StressRecovery::Spr => recover_spr(&mesh.nodes, mesh.n_vertices, &mesh.tets, &verts, &ue, &wanted, lambda, mu),
+            StressRecovery::Average => recover_nodal(mesh.nodes.len(), &mesh.tets, &verts, &ue, &wanted, lambda, mu),
         };
-        Recovered {
-            mesh,
-            tets,
-            nodal,
-            evaluated,
-        }
+        Recovered { mesh, tets, nodal, evaluated }
     }
 
     fn tet_nodal(&self, t: usize) -> [Sym; 10] {
@@ -303,36 +252,19 @@ impl<'a> Recovered<'a> {
                 }
             }
         }
-        let mut ext = Extremum {
-            value: best.0,
-            at: self.mesh.nodes[best.1 as usize],
-            stress: self.nodal[best.1 as usize],
-        };
+        let mut ext = Extremum { value: best.0, at: self.mesh.nodes[best.1 as usize], stress: self.nodal[best.1 as usize] };
         const K: usize = 8;
-        for &t in self
-            .tets
-            .iter()
-            .filter(|&&t| self.mesh.tets[t].contains(&best.1))
-        {
+        for &t in self.tets.iter().filter(|&&t| self.mesh.tets[t].contains(&best.1)) {
             let nodal = self.tet_nodal(t);
             let v = self.mesh.tet_corners(t);
             for i in 0..=K {
                 for j in 0..=K - i {
                     for k in 0..=K - i - j {
-                        let l = [
-                            i as f64 / K as f64,
-                            j as f64 / K as f64,
-                            k as f64 / K as f64,
-                            (K - i - j - k) as f64 / K as f64,
-                        ];
+                        let l = [i as f64 / K as f64, j as f64 / K as f64, k as f64 / K as f64, (K - i - j - k) as f64 / K as f64];
                         let s = eval_p2(&nodal, l);
                         let val = f(&s);
                         if val > ext.value {
-                            ext = Extremum {
-                                value: val,
-                                at: std::array::from_fn(|c| (0..4).map(|q| l[q] * v[q][c]).sum()),
-                                stress: s,
-                            };
+                            ext = Extremum { value: val, at: std::array::from_fn(|c| (0..4).map(|q| l[q] * v[q][c]).sum()), stress: s };
                         }
                     }
                 }
@@ -343,13 +275,7 @@ impl<'a> Recovered<'a> {
 
     /// The maximum of `f` on the plane z = `zc` within `radius` of (x, y) (units of a): a
     /// lattice of step 0.01 a, refined with step 0.002 a around the best point.
-    pub fn maximum_on_plane(
-        &self,
-        f: &dyn Fn(&Sym) -> f64,
-        zc: f64,
-        around: [f64; 2],
-        radius: f64,
-    ) -> Option<Extremum> {
+    pub fn maximum_on_plane(&self, f: &dyn Fn(&Sym) -> f64, zc: f64, around: [f64; 2], radius: f64) -> Option<Extremum> {
         let mut best: Option<Extremum> = None;
         let scan = |c: [f64; 2], r: f64, h: f64, best: &mut Option<Extremum>| {
             let n = (r / h).round() as i64;
@@ -359,11 +285,7 @@ impl<'a> Recovered<'a> {
                     if let Some(s) = self.at(p) {
                         let v = f(&s);
                         if best.as_ref().map_or(true, |b| v > b.value) {
-                            *best = Some(Extremum {
-                                value: v,
-                                at: p,
-                                stress: s,
-                            });
+                            *best = Some(Extremum { value: v, at: p, stress: s });
                         }
                     }
                 }
@@ -405,44 +327,19 @@ impl<'a> Recovered<'a> {
                 l
             };
             let polys: Vec<[[f64; 4]; 3]> = match (neg.len(), pos.len()) {
-                (1, 3) => vec![[
-                    cut(neg[0], pos[0]),
-                    cut(neg[0], pos[1]),
-                    cut(neg[0], pos[2]),
-                ]],
-                (3, 1) => vec![[
-                    cut(pos[0], neg[0]),
-                    cut(pos[0], neg[1]),
-                    cut(pos[0], neg[2]),
-                ]],
+                (1, 3) => vec![[cut(neg[0], pos[0]), cut(neg[0], pos[1]), cut(neg[0], pos[2])]],
+                (3, 1) => vec![[cut(pos[0], neg[0]), cut(pos[0], neg[1]), cut(pos[0], neg[2])]],
                 _ => {
-                    let q = [
-                        cut(neg[0], pos[0]),
-                        cut(neg[0], pos[1]),
-                        cut(neg[1], pos[1]),
-                        cut(neg[1], pos[0]),
-                    ];
+                    let q = [cut(neg[0], pos[0]), cut(neg[0], pos[1]), cut(neg[1], pos[1]), cut(neg[1], pos[0])];
                     vec![[q[0], q[1], q[2]], [q[0], q[2], q[3]]]
                 }
             };
             let nodal = self.tet_nodal(t);
-            let to2d =
-                |l: &[f64; 4]| -> [f64; 2] { plane.map(|k| (0..4).map(|q| l[q] * v[q][k]).sum()) };
+            let to2d = |l: &[f64; 4]| -> [f64; 2] { plane.map(|k| (0..4).map(|q| l[q] * v[q][k]).sum()) };
             for tri in polys {
-                let mid = |a: &[f64; 4], b: &[f64; 4]| -> [f64; 4] {
-                    std::array::from_fn(|k| 0.5 * (a[k] + b[k]))
-                };
-                let (m01, m12, m20) = (
-                    mid(&tri[0], &tri[1]),
-                    mid(&tri[1], &tri[2]),
-                    mid(&tri[2], &tri[0]),
-                );
-                for sub in [
-                    [tri[0], m01, m20],
-                    [m01, tri[1], m12],
-                    [m20, m12, tri[2]],
-                    [m01, m12, m20],
-                ] {
+                let mid = |a: &[f64; 4], b: &[f64; 4]| -> [f64; 4] { std::array::from_fn(|k| 0.5 * (a[k] + b[k])) };
+                let (m01, m12, m20) = (mid(&tri[0], &tri[1]), mid(&tri[1], &tri[2]), mid(&tri[2], &tri[0]));
+                for sub in [[tri[0], m01, m20], [m01, tri[1], m12], [m20, m12, tri[2]], [m01, m12, m20]] {
                     tris.push(sub.map(|l| to2d(&l)));
                     vals.push(sub.map(|l| f(&eval_p2(&nodal, l))));
                 }
@@ -457,13 +354,7 @@ pub fn tau_xy(s: &Sym) -> f64 {
     s[3]
 }
 
-fn extremum_json(
-    name: &str,
-    e: &Extremum,
-    a: f64,
-    ph: f64,
-    out: &mut serde_json::Map<String, serde_json::Value>,
-) {
+fn extremum_json(name: &str, e: &Extremum, a: f64, ph: f64, out: &mut serde_json::Map<String, serde_json::Value>) {
     out.insert(format!("{name}_pa"), json!(e.value * ph));
     out.insert(format!("{name}_x_m"), json!(e.at[0] * a));
     out.insert(format!("{name}_y_m"), json!(e.at[1] * a));
@@ -473,13 +364,7 @@ fn extremum_json(
 
 /// Recovery, outputs and the `subsurface` object of summary.json (rank 0). `u`: per-node
 /// displacement of the elastic solve (unit Young's modulus, traction in units of p_H).
-pub fn recover_and_write(
-    mesh: &Mesh,
-    u: &[[f64; 3]],
-    p: &Params,
-    dir: &Path,
-    log: &dyn Fn(String),
-) -> Result<serde_json::Value, String> {
+pub fn recover_and_write(mesh: &Mesh, u: &[[f64; 3]], p: &Params, dir: &Path, log: &dyn Fn(String)) -> Result<serde_json::Value, String> {
     let t0 = Instant::now();
     let rec = Recovered::new(mesh, u, p.nu, &p.rect, p.method);
     let recovery_s = t0.elapsed().as_secs_f64();
@@ -497,10 +382,7 @@ pub fn recover_and_write(
     extremum_json("von_mises_max", &vm, a, ph, &mut obj);
     extremum_json("tresca_max", &tr, a, ph, &mut obj);
     extremum_json("tau_xy_max", &txy, a, ph, &mut obj);
-    obj.insert(
-        "tau_xy_max_signed_pa".into(),
-        json!(tau_xy(&txy.stress) * ph),
-    );
+    obj.insert("tau_xy_max_signed_pa".into(), json!(tau_xy(&txy.stress) * ph));
     extremum_json("compression_max", &pmin, a, ph, &mut obj);
     // The von Mises maximum on the plane z = 0 through the contact centre (the plane of the
     // x-y maps; the plane of symmetry of a symmetric load), searched near the 3D maximum.
@@ -513,8 +395,7 @@ pub fn recover_and_write(
     ));
     // The stresses along the axis x = z = 0, depth 0 to REGION_DEPTH.
     let t1 = Instant::now();
-    let mut csv =
-        String::from("depth_m,sxx_pa,syy_pa,szz_pa,sxy_pa,syz_pa,sxz_pa,von_mises_pa,tresca_pa\n");
+    let mut csv = String::from("depth_m,sxx_pa,syy_pa,szz_pa,sxy_pa,syz_pa,sxz_pa,von_mises_pa,tresca_pa\n");
     for i in 0..=300 {
         let d = REGION_DEPTH * i as f64 / 300.0;
         if let Some(s) = rec.at([0.0, -d, 0.0]) {
@@ -522,16 +403,11 @@ pub fn recover_and_write(
             for c in s {
                 csv.push_str(&format!(",{:e}", c * ph));
             }
-            csv.push_str(&format!(
-                ",{:e},{:e}\n",
-                von_mises(&s) * ph,
-                tresca(&s) * ph
-            ));
+            csv.push_str(&format!(",{:e},{:e}\n", von_mises(&s) * ph, tresca(&s) * ph));
         }
     }
     let path = dir.join("subsurface_axis.csv");
-    crate::output::write_atomic(&path, csv.as_bytes())
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    crate::output::write_atomic(&path, csv.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     if p.vtu {
         write_region_vtu(&rec, u, p, &dir.join("subsurface.vtu"))?;
     }
@@ -549,40 +425,19 @@ pub fn maxima_only(mesh: &Mesh, u: &[[f64; 3]], p: &Params) -> serde_json::Value
     let rec = Recovered::new(mesh, u, p.nu, &p.rect, p.method);
     let mut obj = serde_json::Map::new();
     obj.insert("surface_traction".into(), json!(p.traction));
-    extremum_json(
-        "von_mises_max",
-        &rec.maximum(&von_mises),
-        p.a,
-        p.ph,
-        &mut obj,
-    );
+    extremum_json("von_mises_max", &rec.maximum(&von_mises), p.a, p.ph, &mut obj);
     extremum_json("tresca_max", &rec.maximum(&tresca), p.a, p.ph, &mut obj);
     let txy = rec.maximum(&|s: &Sym| tau_xy(s).abs());
     extremum_json("tau_xy_max", &txy, p.a, p.ph, &mut obj);
-    obj.insert(
-        "tau_xy_max_signed_pa".into(),
-        json!(tau_xy(&txy.stress) * p.ph),
-    );
+    obj.insert("tau_xy_max_signed_pa".into(), json!(tau_xy(&txy.stress) * p.ph));
     serde_json::Value::Object(obj)
 }
 
-fn write_region_vtu(
-    rec: &Recovered,
-    u: &[[f64; 3]],
-    p: &Params,
-    path: &Path,
-) -> Result<(), String> {
+fn write_region_vtu(rec: &Recovered, u: &[[f64; 3]], p: &Params, path: &Path) -> Result<(), String> {
     let mesh = rec.mesh;
     let mut id = vec![u32::MAX; mesh.nodes.len()];
     let mut points = Vec::new();
-    let (mut disp, mut stress, mut vm, mut tr, mut txy, mut pr) = (
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-    );
+    let (mut disp, mut stress, mut vm, mut tr, mut txy, mut pr) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let uscale = p.a * p.ph / p.e;
     let mut conn = Vec::with_capacity(10 * rec.tets.len());
     for &t in &rec.tets {
@@ -603,36 +458,12 @@ fn write_region_vtu(
         }
     }
     let fields = [
-        Field {
-            name: "displacement_m",
-            components: 3,
-            values: &disp,
-        },
-        Field {
-            name: "stress_pa",
-            components: 6,
-            values: &stress,
-        },
-        Field {
-            name: "von_mises_pa",
-            components: 1,
-            values: &vm,
-        },
-        Field {
-            name: "tresca_pa",
-            components: 1,
-            values: &tr,
-        },
-        Field {
-            name: "tau_xy_pa",
-            components: 1,
-            values: &txy,
-        },
-        Field {
-            name: "principal_pa",
-            components: 3,
-            values: &pr,
-        },
+        Field { name: "displacement_m", components: 3, values: &disp },
+        Field { name: "stress_pa", components: 6, values: &stress },
+        Field { name: "von_mises_pa", components: 1, values: &vm },
+        Field { name: "tresca_pa", components: 1, values: &tr },
+        Field { name: "tau_xy_pa", components: 1, values: &txy },
+        Field { name: "principal_pa", components: 3, values: &pr },
     ];
     crate::output::write_atomic_with(path, |t| {
         write_vtu_single_type(t, &points, VTK_QUADRATIC_TETRA, &conn, &fields, &[])
@@ -641,27 +472,13 @@ fn write_region_vtu(
 }
 
 /// PNG maps of von Mises and tau_xy on the sections z = 0 (x-y plane) and x = 0 (z-y plane).
-fn write_sections(
-    rec: &Recovered,
-    p: &Params,
-    dir: &Path,
-    vm: &Extremum,
-    txy: &Extremum,
-) -> Result<(), String> {
+fn write_sections(rec: &Recovered, p: &Params, dir: &Path, vm: &Extremum, txy: &Extremum) -> Result<(), String> {
     use crate::output::plot::{map_plot, MapOpts};
     let ph_mpa = p.ph * 1e-6;
     let depth = 2.0_f64.min(REGION_DEPTH);
     type Scalar = fn(&Sym) -> f64;
-    let fields: [(&str, &str, Scalar, bool, &Extremum); 2] = [
-        ("von_mises", "von Mises stress", von_mises, false, vm),
-        (
-            "tau_xy",
-            "orthogonal shear stress tau_xy",
-            tau_xy,
-            true,
-            txy,
-        ),
-    ];
+    let fields: [(&str, &str, Scalar, bool, &Extremum); 2] =
+        [("von_mises", "von Mises stress", von_mises, false, vm), ("tau_xy", "orthogonal shear stress tau_xy", tau_xy, true, txy)];
     for (key, title, f, diverging, ext) in fields {
         let g = |s: &Sym| f(s) * ph_mpa;
         // x-y section through the contact centre (z = 0).
@@ -697,24 +514,13 @@ fn write_sections(
             }
         }
         let opts = MapOpts {
-            x_range: Some((
-                p.rect.z0.max(-2.5),
-                (if p.half { -p.rect.z0 } else { p.rect.z1 }).min(2.5),
-            )),
+            x_range: Some((p.rect.z0.max(-2.5), (if p.half { -p.rect.z0 } else { p.rect.z1 }).min(2.5))),
             circle: (ext.at[0].abs() < 0.05).then_some((ext.at[2], ext.at[1], 0.03)),
             ..opts
         };
         let path = dir.join(format!("subsurface_{key}_zy.png"));
         crate::output::write_atomic_with(&path, |t| {
-            map_plot(
-                t,
-                &format!("{title}, section x = 0"),
-                "z / a",
-                "y / a (depth below the contact)",
-                &tris,
-                &vals,
-                &opts,
-            )
+            map_plot(t, &format!("{title}, section x = 0"), "z / a", "y / a (depth below the contact)", &tris, &vals, &opts)
         })?;
     }
     Ok(())

@@ -26,7 +26,12 @@ pub struct SweepRow {
 }
 
 fn point_label(p: &Scene) -> String {
-    format!("Ue = {} m/s, lambda = {} deg, SRR = {}", p.operating.entrainment_speed.unwrap_or(f64::NAN), p.operating.tilt_angle, p.operating.slide_to_roll)
+    format!(
+        "Ue = {} m/s, lambda = {} deg, SRR = {}",
+        p.operating.entrainment_speed.unwrap_or(f64::NAN),
+        p.operating.tilt_angle,
+        p.operating.slide_to_roll
+    )
 }
 
 pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> Result<(), String> {
@@ -48,7 +53,10 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
         let result = match solved {
             Ok(sol) => {
                 its = sol.newton_total;
-                let r = collective::agree(&ctx.world, post_point(ctx, p, setup, &sol, solver.condensation_s.map(|c| if k == 0 { c } else { 0.0 }), &dir));
+                let r = collective::agree(
+                    &ctx.world,
+                    post_point(ctx, p, setup, &sol, solver.condensation_s.map(|c| if k == 0 { c } else { 0.0 }), &dir),
+                );
                 if r.is_ok() {
                     prev = Some(sol.x);
                 }
@@ -71,7 +79,14 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
                 }
             }
         }
-        rows.push(SweepRow { ue: p.operating.entrainment_speed.unwrap_or(f64::NAN), lambda_deg: p.operating.tilt_angle, srr: p.operating.slide_to_roll, result, newton_iterations: its, wall_s });
+        rows.push(SweepRow {
+            ue: p.operating.entrainment_speed.unwrap_or(f64::NAN),
+            lambda_deg: p.operating.tilt_angle,
+            srr: p.operating.slide_to_roll,
+            result,
+            newton_iterations: its,
+            wall_s,
+        });
         if ctx.rank == 0 {
             write_table(ctx, &rows)?;
         }
@@ -79,9 +94,21 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
     if ctx.rank == 0 && scene.output.png {
         sweep_plots(ctx, scene, &rows)?;
     }
-    let failed: Vec<String> = rows.iter().enumerate().filter(|(_, r)| r.result.is_err()).map(|(i, r)| format!("point {} ({})", i + 1, format_args!("Ue = {}, lambda = {}, SRR = {}", r.ue, r.lambda_deg, r.srr))).collect();
+    let failed: Vec<String> = rows
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.result.is_err())
+        .map(|(i, r)| format!("point {} ({})", i + 1, format_args!("Ue = {}, lambda = {}, SRR = {}", r.ue, r.lambda_deg, r.srr)))
+        .collect();
     let total: f64 = rows.iter().map(|r| r.wall_s).sum();
-    ctx.log(format!("sweep done: {} of {} points converged, {:.1} s of solves ({:.1} s per point); table {}", n - failed.len(), n, total, total / n as f64, ctx.out_dir.join("sweep.csv").display()));
+    ctx.log(format!(
+        "sweep done: {} of {} points converged, {:.1} s of solves ({:.1} s per point); table {}",
+        n - failed.len(),
+        n,
+        total,
+        total / n as f64,
+        ctx.out_dir.join("sweep.csv").display()
+    ));
     if failed.is_empty() {
         Ok(())
     } else {
@@ -91,12 +118,24 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
 
 /// `sweep.csv`: one row per point, in sweep order.
 fn write_table(ctx: &Context, rows: &[SweepRow]) -> Result<(), String> {
-    let mut t = String::from("point,ue_m_s,tilt_angle_deg,slide_to_roll,status,hc_m,hm_m,pmax_pa,load_error_rel,fx,fz,newton_iterations,wall_s,reason\n");
+    let mut t = String::from(
+        "point,ue_m_s,tilt_angle_deg,slide_to_roll,status,hc_m,hm_m,pmax_pa,load_error_rel,fx,fz,newton_iterations,wall_s,reason\n",
+    );
     let opt = |v: Option<f64>| v.map(|x| format!("{x:e}")).unwrap_or_default();
     for (i, r) in rows.iter().enumerate() {
         let head = format!("{},{},{},{}", i + 1, r.ue, r.lambda_deg, r.srr);
         match &r.result {
-            Ok(p) => t.push_str(&format!("{head},converged,{:e},{:e},{:e},{:e},{},{},{},{:.2},\n", p.hc, p.hm, p.pmax, p.load_error, opt(p.fx), opt(p.fz), r.newton_iterations, r.wall_s)),
+            Ok(p) => t.push_str(&format!(
+                "{head},converged,{:e},{:e},{:e},{:e},{},{},{},{:.2},\n",
+                p.hc,
+                p.hm,
+                p.pmax,
+                p.load_error,
+                opt(p.fx),
+                opt(p.fz),
+                r.newton_iterations,
+                r.wall_s
+            )),
             Err(e) => t.push_str(&format!("{head},failed,,,,,,,{},{:.2},\"{}\"\n", r.newton_iterations, r.wall_s, e.replace('"', "'"))),
         }
     }
@@ -128,7 +167,11 @@ impl Axis {
         }
     }
     fn scale(self) -> f64 {
-        if self == Axis::Srr { 100.0 } else { 1.0 }
+        if self == Axis::Srr {
+            100.0
+        } else {
+            1.0
+        }
     }
     fn legend(self, r: &SweepRow) -> String {
         match self {
@@ -141,7 +184,13 @@ impl Axis {
 
 /// Series of `y` against `axis`, one per combination of the other swept parameters
 /// (converged points only).
-fn series_along(rows: &[SweepRow], axis: Axis, others: &[Axis], name: &str, y: &dyn Fn(&SweepRow, &PointResult) -> Option<f64>) -> Vec<Series> {
+fn series_along(
+    rows: &[SweepRow],
+    axis: Axis,
+    others: &[Axis],
+    name: &str,
+    y: &dyn Fn(&SweepRow, &PointResult) -> Option<f64>,
+) -> Vec<Series> {
     let mut groups: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     for r in rows {
         let Ok(p) = &r.result else { continue };
@@ -167,11 +216,12 @@ fn series_along(rows: &[SweepRow], axis: Axis, others: &[Axis], name: &str, y: &
 /// h_lambda/h_90 when lambda = 90 deg is in the sweep, and fx, fz against SRR.
 fn sweep_plots(ctx: &Context, scene: &Scene, rows: &[SweepRow]) -> Result<(), String> {
     let sw = scene.sweep.clone().unwrap_or_default();
-    let varied: Vec<Axis> = [(Axis::Speed, sw.entrainment_speed.as_ref()), (Axis::Tilt, sw.tilt_angle.as_ref()), (Axis::Srr, sw.slide_to_roll.as_ref())]
-        .into_iter()
-        .filter(|(_, l)| l.map_or(0, |v| v.len()) > 1)
-        .map(|(a, _)| a)
-        .collect();
+    let varied: Vec<Axis> =
+        [(Axis::Speed, sw.entrainment_speed.as_ref()), (Axis::Tilt, sw.tilt_angle.as_ref()), (Axis::Srr, sw.slide_to_roll.as_ref())]
+            .into_iter()
+            .filter(|(_, l)| l.map_or(0, |v| v.len()) > 1)
+            .map(|(a, _)| a)
+            .collect();
     let write = |name: &str, title: &str, xlabel: &str, ylabel: &str, series: Vec<Series>, log_x: bool| -> Result<(), String> {
         if series.is_empty() {
             return Ok(());
@@ -189,11 +239,32 @@ fn sweep_plots(ctx: &Context, scene: &Scene, rows: &[SweepRow]) -> Result<(), St
         };
         let mut film = series_along(rows, axis, &others, "hc", &|_, p| Some(p.hc * 1e6));
         film.extend(series_along(rows, axis, &others, "hm", &|_, p| Some(p.hm * 1e6)));
-        write(&format!("sweep_film_vs_{tag}.png"), &format!("film thickness against {}", axis.label()), axis.label(), "h (um)", film, log_x)?;
+        write(
+            &format!("sweep_film_vs_{tag}.png"),
+            &format!("film thickness against {}", axis.label()),
+            axis.label(),
+            "h (um)",
+            film,
+            log_x,
+        )?;
         let fx = series_along(rows, axis, &others, "fx", &|_, p| p.fx);
-        write(&format!("sweep_fx_vs_{tag}.png"), &format!("friction coefficient fx against {}", axis.label()), axis.label(), "fx", fx, log_x)?;
+        write(
+            &format!("sweep_fx_vs_{tag}.png"),
+            &format!("friction coefficient fx against {}", axis.label()),
+            axis.label(),
+            "fx",
+            fx,
+            log_x,
+        )?;
         let fz = series_along(rows, axis, &others, "fz", &|_, p| p.fz);
-        write(&format!("sweep_fz_vs_{tag}.png"), &format!("transverse friction coefficient fz against {}", axis.label()), axis.label(), "fz", fz, log_x)?;
+        write(
+            &format!("sweep_fz_vs_{tag}.png"),
+            &format!("transverse friction coefficient fz against {}", axis.label()),
+            axis.label(),
+            "fz",
+            fz,
+            log_x,
+        )?;
         if axis == Axis::Tilt {
             // h_lambda / h_90 of the same (Ue, SRR).
             let base = |r: &SweepRow, f: &dyn Fn(&PointResult) -> f64| -> Option<f64> {
@@ -201,7 +272,14 @@ fn sweep_plots(ctx: &Context, scene: &Scene, rows: &[SweepRow]) -> Result<(), St
             };
             let mut ratio = series_along(rows, axis, &others, "hc/hc90", &|r, p| base(r, &|q| q.hc).map(|b| p.hc / b));
             ratio.extend(series_along(rows, axis, &others, "hm/hm90", &|r, p| base(r, &|q| q.hm).map(|b| p.hm / b)));
-            write("sweep_film_ratio_vs_tilt.png", "film thickness relative to lambda = 90 deg", axis.label(), "h_lambda / h_90", ratio, true)?;
+            write(
+                "sweep_film_ratio_vs_tilt.png",
+                "film thickness relative to lambda = 90 deg",
+                axis.label(),
+                "h_lambda / h_90",
+                ratio,
+                true,
+            )?;
             profiles_by_tilt(ctx, rows)?;
         }
     }
@@ -224,7 +302,12 @@ fn profiles_by_tilt(ctx: &Context, rows: &[SweepRow]) -> Result<(), String> {
             let Ok(p) = &r.result else { continue };
             let pts: Vec<&[f64; 2]> = p.profile_x0.iter().filter(|q| q[0].abs() <= 1.5).collect();
             hmax = hmax.max(2.0 * p.hc * 1e6);
-            series.push(Series::new(&format!("lambda {} deg", r.lambda_deg), pts.iter().map(|q| q[0]).collect(), pts.iter().map(|q| q[1] * 1e6).collect(), Style::Line));
+            series.push(Series::new(
+                &format!("lambda {} deg", r.lambda_deg),
+                pts.iter().map(|q| q[0]).collect(),
+                pts.iter().map(|q| q[1] * 1e6).collect(),
+                Style::Line,
+            ));
         }
         if series.is_empty() {
             continue;

@@ -47,7 +47,8 @@ fn run(cli: Cli) -> Result<i32, String> {
     match cli.cmd {
         Cmd::Compare { reference, new, tolerances, rel, label } => {
             let mut tol = match &tolerances {
-                Some(p) => Tolerances::parse(&std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?).map_err(|e| format!("{}: {e}", p.display()))?,
+                Some(p) => Tolerances::parse(&std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?)
+                    .map_err(|e| format!("{}: {e}", p.display()))?,
                 None => Tolerances::uniform(1e-6),
             };
             if let Some(r) = rel {
@@ -56,7 +57,12 @@ fn run(cli: Cli) -> Result<i32, String> {
             let c = regress::compare(&read_json(&reference)?, &read_json(&new)?, &tol);
             print!("{}", c.table());
             let verdict = if c.failures() == 0 { "PASS" } else { "DRIFT" };
-            println!("{verdict}{}: {} against {}", if label.is_empty() { String::new() } else { format!(" {label}") }, new.display(), reference.display());
+            println!(
+                "{verdict}{}: {} against {}",
+                if label.is_empty() { String::new() } else { format!(" {label}") },
+                new.display(),
+                reference.display()
+            );
             Ok(if c.failures() == 0 { 0 } else { 1 })
         }
         Cmd::Get { file, keys } => {
@@ -74,7 +80,8 @@ fn run(cli: Cli) -> Result<i32, String> {
         Cmd::Hard { outdir, cases } => {
             let load = |case: &str, mesh: &str| -> hard::Run {
                 let base = outdir.join(case).join(mesh);
-                let wall_s = std::fs::read_to_string(base.with_extension("wall")).ok().and_then(|t| t.trim().parse().ok()).unwrap_or(f64::NAN);
+                let wall_s =
+                    std::fs::read_to_string(base.with_extension("wall")).ok().and_then(|t| t.trim().parse().ok()).unwrap_or(f64::NAN);
                 match read_json(&base.join("summary.json")) {
                     Ok(s) => hard::Run { summary: Some(s), wall_s, error: None },
                     Err(_) => {

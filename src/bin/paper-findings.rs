@@ -69,7 +69,16 @@ impl Sweep {
     }
     /// The row (and its 1-based point number) at (Ue, lambda, SRR).
     fn at(&self, ue: f64, lambda: f64, srr: f64) -> Option<(usize, &HashMap<String, String>)> {
-        self.rows.iter().enumerate().find(|(_, r)| f(r, "ue_m_s") == ue && f(r, "tilt_angle_deg") == lambda && (f(r, "slide_to_roll") - srr).abs() < 1e-12 && r.get("status").map(String::as_str) == Some("converged")).map(|(i, r)| (i + 1, r))
+        self.rows
+            .iter()
+            .enumerate()
+            .find(|(_, r)| {
+                f(r, "ue_m_s") == ue
+                    && f(r, "tilt_angle_deg") == lambda
+                    && (f(r, "slide_to_roll") - srr).abs() < 1e-12
+                    && r.get("status").map(String::as_str) == Some("converged")
+            })
+            .map(|(i, r)| (i + 1, r))
     }
     fn get(&self, ue: f64, lambda: f64, srr: f64, key: &str) -> f64 {
         self.at(ue, lambda, srr).map(|(_, r)| f(r, key)).unwrap_or(f64::NAN)
@@ -105,7 +114,11 @@ fn figs_4_6(dir: &Path) -> Res<()> {
     // 1a: hc unchanged for lambda > 2, hm unchanged for lambda > 4 (within 1 %).
     let dev_hc = ues.iter().flat_map(|&u| [7.0, 4.0].map(|l| (ratio(u, l, "hc_m") - 1.0).abs())).fold(0.0, f64::max);
     let dev_hm = ues.iter().map(|&u| (ratio(u, 7.0, "hm_m") - 1.0).abs()).fold(0.0, f64::max);
-    println!("1a. hc unchanged for lambda in {{4, 7}} deg: max |hc/hc90 - 1| = {:.2} % (< 1 %): {}", 100.0 * dev_hc, verdict(dev_hc < 0.01));
+    println!(
+        "1a. hc unchanged for lambda in {{4, 7}} deg: max |hc/hc90 - 1| = {:.2} % (< 1 %): {}",
+        100.0 * dev_hc,
+        verdict(dev_hc < 0.01)
+    );
     println!("1b. hm unchanged at lambda = 7 deg: max |hm/hm90 - 1| = {:.2} % (< 1 %): {}", 100.0 * dev_hm, verdict(dev_hm < 0.01));
     let hc7 = ues.iter().map(|&u| (ratio(u, 7.0, "hc_m") - 1.0).abs()).fold(0.0, f64::max);
     println!("    issue check |hc(7)/hc(90) - 1| < 1 %: {:.2} %: {}", 100.0 * hc7, verdict(hc7 < 0.01));
@@ -123,11 +136,15 @@ fn figs_4_6(dir: &Path) -> Res<()> {
     let a = summary(&s.point_dir(ues[0], 90.0, 0.0).ok_or("no lambda = 90 point")?)?.hertz.a_m;
     let mut asym = Vec::new();
     for &u in &ues {
-        let prof = |l: f64| -> Res<Vec<HashMap<String, String>>> { csv(&s.point_dir(u, l, 0.0).ok_or(format!("no point Ue {u} lambda {l}"))?.join("profile_x0.csv")) };
+        let prof = |l: f64| -> Res<Vec<HashMap<String, String>>> {
+            csv(&s.point_dir(u, l, 0.0).ok_or(format!("no point Ue {u} lambda {l}"))?.join("profile_x0.csv"))
+        };
         let p90 = prof(90.0)?;
         let hc90 = s.get(u, 90.0, 0.0, "hc_m");
         let p7 = prof(7.0)?;
-        let dmax = p90.iter().zip(&p7).filter(|(r, _)| f(r, "z_m").abs() <= a).map(|(r, q)| (f(r, "h_m") - f(q, "h_m")).abs()).fold(0.0, f64::max) / hc90;
+        let dmax =
+            p90.iter().zip(&p7).filter(|(r, _)| f(r, "z_m").abs() <= a).map(|(r, q)| (f(r, "h_m") - f(q, "h_m")).abs()).fold(0.0, f64::max)
+                / hc90;
         println!("2a. Ue = {u}: profiles on x = 0 at lambda = 90 and 7 deg differ by at most {:.2} % of hc over |z| <= a (almost the same: < 2 %): {}", 100.0 * dmax, verdict(dmax < 0.02));
         for l in [2.0, 1.0, 0.5] {
             let p = prof(l)?;
@@ -138,13 +155,24 @@ fn figs_4_6(dir: &Path) -> Res<()> {
             if l == 0.5 {
                 asym.push((u, hp_ - hm_, rel));
             }
-            println!("2b. Ue = {u}, lambda = {l}: h(0, -a) = {:.4} um < h(0, +a) = {:.4} um: {};  (h(+0.8a) - h(-0.8a))/hc = {:.3}", hm_ * 1e6, hp_ * 1e6, verdict(hm_ < hp_), rel);
+            println!(
+                "2b. Ue = {u}, lambda = {l}: h(0, -a) = {:.4} um < h(0, +a) = {:.4} um: {};  (h(+0.8a) - h(-0.8a))/hc = {:.3}",
+                hm_ * 1e6,
+                hp_ * 1e6,
+                verdict(hm_ < hp_),
+                rel
+            );
         }
         // 3: pressure not significantly changed by spin.
         let p05 = prof(0.5)?;
         let ph = summary(&s.point_dir(u, 90.0, 0.0).unwrap())?.hertz.ph_pa;
         let dp = p90.iter().zip(&p05).map(|(r, q)| (f(r, "p_pa") - f(q, "p_pa")).abs()).fold(0.0, f64::max) / ph;
-        println!("3.  Ue = {u}: max |p(0.5 deg) - p(90 deg)| on x = 0 = {:.3} p_H, pmax ratio {:.4} (not significantly changed: < 0.1 p_H): {}", dp, s.get(u, 0.5, 0.0, "pmax_pa") / s.get(u, 90.0, 0.0, "pmax_pa"), verdict(dp < 0.1));
+        println!(
+            "3.  Ue = {u}: max |p(0.5 deg) - p(90 deg)| on x = 0 = {:.3} p_H, pmax ratio {:.4} (not significantly changed: < 0.1 p_H): {}",
+            dp,
+            s.get(u, 0.5, 0.0, "pmax_pa") / s.get(u, 90.0, 0.0, "pmax_pa"),
+            verdict(dp < 0.1)
+        );
     }
     if asym.len() >= 2 {
         let (lo, hi) = (asym[0], asym[asym.len() - 1]);
@@ -177,10 +205,20 @@ fn figs_7_8(dir: &Path) -> Res<()> {
     }
     println!();
     let fx = |l: f64, r: f64| s.get(ue, l, r, "fx");
-    println!("4a. SRR = 5 %: fx(2 deg) = {:.4} < fx(90 deg) = {:.4}: {}", fx(2.0, 0.05), fx(90.0, 0.05), verdict(fx(2.0, 0.05) < fx(90.0, 0.05)));
+    println!(
+        "4a. SRR = 5 %: fx(2 deg) = {:.4} < fx(90 deg) = {:.4}: {}",
+        fx(2.0, 0.05),
+        fx(90.0, 0.05),
+        verdict(fx(2.0, 0.05) < fx(90.0, 0.05))
+    );
     let slopes: Vec<f64> = LAMBDAS.iter().map(|&l| (fx(l, 0.01) - fx(l, -0.01)) / 0.02).collect();
     let decreasing = slopes.windows(2).all(|w| w[1] <= w[0] * 1.001);
-    println!("4b. slope dfx/dSRR at SRR = 0 for lambda = {:?}: {:?}; smaller lambda, smaller slope: {}", LAMBDAS, slopes.iter().map(|x| (x * 1e3).round() / 1e3).collect::<Vec<_>>(), verdict(decreasing));
+    println!(
+        "4b. slope dfx/dSRR at SRR = 0 for lambda = {:?}: {:?}; smaller lambda, smaller slope: {}",
+        LAMBDAS,
+        slopes.iter().map(|x| (x * 1e3).round() / 1e3).collect::<Vec<_>>(),
+        verdict(decreasing)
+    );
     // "Friction falls roughly in proportion" for SRR <= 10 % and lambda <= 7 deg: read as
     // fx proportional to lambda, i.e. fx(lambda) / fx(lambda') = lambda / lambda'.
     let pairs = [(4.0, 7.0), (2.0, 4.0), (1.0, 2.0), (0.5, 1.0)];
@@ -196,10 +234,20 @@ fn figs_7_8(dir: &Path) -> Res<()> {
             .collect();
         println!("4c. SRR = {} %: {}", sr * 100.0, r.join(", "));
     }
-    println!("4c. fx proportional to lambda for lambda <= 7 deg, SRR <= 10 %: worst deviation of the ratios {:.0} % (roughly: < 20 %): {}", 100.0 * worst, verdict(worst < 0.2));
+    println!(
+        "4c. fx proportional to lambda for lambda <= 7 deg, SRR <= 10 %: worst deviation of the ratios {:.0} % (roughly: < 20 %): {}",
+        100.0 * worst,
+        verdict(worst < 0.2)
+    );
     let max_fx = s.rows.iter().map(|r| f(r, "fx").abs()).filter(|x| x.is_finite()).fold(0.0, f64::max);
     let max_fz = s.rows.iter().map(|r| f(r, "fz").abs()).filter(|x| x.is_finite()).fold(0.0, f64::max);
-    println!("5a. max |fz| / max |fx| = {:.2e} / {:.2e} = {:.1e} (about two orders: in [3e-3, 3e-2]): {}", max_fz, max_fx, max_fz / max_fx, verdict((3e-3..3e-2).contains(&(max_fz / max_fx))));
+    println!(
+        "5a. max |fz| / max |fx| = {:.2e} / {:.2e} = {:.1e} (about two orders: in [3e-3, 3e-2]): {}",
+        max_fz,
+        max_fx,
+        max_fz / max_fx,
+        verdict((3e-3..3e-2).contains(&(max_fz / max_fx)))
+    );
     for l in LAMBDAS {
         let (mut best, mut at) = (0.0f64, f64::NAN);
         for &r in &srrs {
@@ -212,7 +260,11 @@ fn figs_7_8(dir: &Path) -> Res<()> {
         // Width: the SRR range where |fz| >= max/2.
         let above: Vec<f64> = srrs.iter().copied().filter(|&r| s.get(ue, l, r, "fz").abs() >= 0.5 * best).collect();
         let width = above.last().unwrap_or(&f64::NAN) - above.first().unwrap_or(&f64::NAN);
-        println!("5b. lambda = {l}: max |fz| = {best:.3e} at SRR = {} %, half-height width {} % of SRR", at * 100.0, (width * 1e4).round() / 1e2);
+        println!(
+            "5b. lambda = {l}: max |fz| = {best:.3e} at SRR = {} %, half-height width {} % of SRR",
+            at * 100.0,
+            (width * 1e4).round() / 1e2
+        );
     }
     println!();
     Ok(())
@@ -249,12 +301,30 @@ fn cases(c1: &Path, c2: &Path) -> Res<()> {
     let (a1x, b1x) = transverse(c1)?;
     println!("6a. Case 1 (lambda = 90): tau_yx on the line in [{:.2}, {:.2}] MPa, correlation with p = {c1r:.3} (follows the pressure: > 0.8): {}", a1 * 1e-6, b1 * 1e-6, verdict(c1r > 0.8));
     let split = a2 < -0.1 * b2.abs().max(a2.abs()) && b2 > 0.1 * b2.abs().max(a2.abs());
-    println!("6b. Case 2 (lambda = 2): tau_yx on x = 0, |z| <= a in [{:.2}, {:.2}] MPa (zones of opposite sign: {}); Case 1: [{:.2}, {:.2}] MPa", a2 * 1e-6, b2 * 1e-6, verdict(split), a1x * 1e-6, b1x * 1e-6);
-    println!("6c. max |tau_yz| on the line: Case 1 {:.2} MPa vs Case 2 {:.2} MPa (near zero in Case 1, strong in Case 2): {}", z1 * 1e-6, z2 * 1e-6, verdict(z1 < 0.3 * z2));
+    println!(
+        "6b. Case 2 (lambda = 2): tau_yx on x = 0, |z| <= a in [{:.2}, {:.2}] MPa (zones of opposite sign: {}); Case 1: [{:.2}, {:.2}] MPa",
+        a2 * 1e-6,
+        b2 * 1e-6,
+        verdict(split),
+        a1x * 1e-6,
+        b1x * 1e-6
+    );
+    println!(
+        "6c. max |tau_yz| on the line: Case 1 {:.2} MPa vs Case 2 {:.2} MPa (near zero in Case 1, strong in Case 2): {}",
+        z1 * 1e-6,
+        z2 * 1e-6,
+        verdict(z1 < 0.3 * z2)
+    );
     println!("6d. Case 2 tau_yz has both signs on the line, the weaker zone reaching {:.2} MPa", zz2 * 1e-6);
     for (name, d) in [("Case 1", c1), ("Case 2", c2)] {
         let s = summary(d)?;
-        println!("    {name}: hc {:.4} um, hm {:.4} um, fx {:.4}, fz {:.3e}", s.film.hc_m * 1e6, s.film.hm_m * 1e6, friction(&s).0, friction(&s).1);
+        println!(
+            "    {name}: hc {:.4} um, hm {:.4} um, fx {:.4}, fz {:.3e}",
+            s.film.hc_m * 1e6,
+            s.film.hm_m * 1e6,
+            friction(&s).0,
+            friction(&s).1
+        );
     }
     println!();
     Ok(())
@@ -283,7 +353,11 @@ fn extra(dirs: &[PathBuf]) -> Res<()> {
 }
 
 fn main() {
-    let mut dirs: HashMap<&str, PathBuf> = [("fig4-6", "out/fig4-6"), ("fig7-8", "out/fig7-8"), ("case1", "out/case1"), ("case2", "out/case2")].into_iter().map(|(k, v)| (k, PathBuf::from(v))).collect();
+    let mut dirs: HashMap<&str, PathBuf> =
+        [("fig4-6", "out/fig4-6"), ("fig7-8", "out/fig7-8"), ("case1", "out/case1"), ("case2", "out/case2")]
+            .into_iter()
+            .map(|(k, v)| (k, PathBuf::from(v)))
+            .collect();
     let mut extras = Vec::new();
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut i = 0;

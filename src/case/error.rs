@@ -87,17 +87,9 @@ impl fmt::Display for SceneErrorKind {
         match self {
             SceneErrorKind::Io(e) => write!(f, "{e}"),
             SceneErrorKind::Syntax(m) => write!(f, "invalid TOML: {}", m.trim_end()),
-            SceneErrorKind::UnknownKey {
-                path,
-                suggestion,
-                known,
-            } => match suggestion {
+            SceneErrorKind::UnknownKey { path, suggestion, known } => match suggestion {
                 Some(s) => write!(f, "unknown key '{path}' (did you mean '{s}'?)"),
-                None => write!(
-                    f,
-                    "unknown key '{path}' (known keys here: {})",
-                    known.join(", ")
-                ),
+                None => write!(f, "unknown key '{path}' (known keys here: {})", known.join(", ")),
             },
             SceneErrorKind::MissingField { path, description } => {
                 write!(f, "missing field '{path}' ({description})")
@@ -105,21 +97,10 @@ impl fmt::Display for SceneErrorKind {
             SceneErrorKind::MissingSection { path, description } => {
                 write!(f, "missing section '[{path}]' ({description})")
             }
-            SceneErrorKind::WrongType {
-                path,
-                expected,
-                found,
-            } => {
-                write!(
-                    f,
-                    "{path} has the wrong type: expected {expected}, found {found}"
-                )
+            SceneErrorKind::WrongType { path, expected, found } => {
+                write!(f, "{path} has the wrong type: expected {expected}, found {found}")
             }
-            SceneErrorKind::NotAllowed {
-                path,
-                value,
-                allowed,
-            } => {
+            SceneErrorKind::NotAllowed { path, value, allowed } => {
                 write!(f, "{path} = {value} is not allowed: {allowed}")
             }
             SceneErrorKind::Conflict(m) => write!(f, "{m}"),

@@ -27,10 +27,7 @@ use serde::Deserialize;
 pub use error::{SceneError, SceneErrorKind};
 pub use schema::*;
 
-use crate::physics::{
-    equivalent_solid, DensityLaw, HamrockDowson, Hertz, Kinematics, Material, MoesParameters,
-    Scales, ViscosityLaw,
-};
+use crate::physics::{equivalent_solid, DensityLaw, HamrockDowson, Hertz, Kinematics, Material, MoesParameters, Scales, ViscosityLaw};
 use spec::fmt_num;
 
 /// Reads and validates the scene file at `path`. The scene name defaults to the file stem,
@@ -81,21 +78,24 @@ pub fn read_bounded(path: &Path, limit: u64) -> std::io::Result<String> {
 /// The `--set KEY=VALUE` whose key the error is about, if any.
 fn overridden<'a>(e: &SceneError, overrides: &'a [String]) -> Option<&'a String> {
     let path = match &e.kind {
-        SceneErrorKind::UnknownKey { path, .. } | SceneErrorKind::WrongType { path, .. } | SceneErrorKind::NotAllowed { path, .. } => path.as_str(),
+        SceneErrorKind::UnknownKey { path, .. } | SceneErrorKind::WrongType { path, .. } | SceneErrorKind::NotAllowed { path, .. } => {
+            path.as_str()
+        }
         _ => return None,
     };
     // The last override of that key (or of the list it indexes) wins.
     let base = path.split('[').next().unwrap_or(path);
-    overrides.iter().rev().find(|o| o.split_once('=').is_some_and(|(k, _)| k.trim() == base || base.starts_with(&format!("{}.", k.trim())) || k.trim().starts_with(&format!("{base}."))))
+    overrides.iter().rev().find(|o| {
+        o.split_once('=').is_some_and(|(k, _)| {
+            k.trim() == base || base.starts_with(&format!("{}.", k.trim())) || k.trim().starts_with(&format!("{base}."))
+        })
+    })
 }
 
 fn default_name(path: &Path) -> String {
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
     if stem == "case" || stem == "scene" {
-        let parent = path
-            .parent()
-            .and_then(|p| p.file_name())
-            .and_then(|s| s.to_str());
+        let parent = path.parent().and_then(|p| p.file_name()).and_then(|s| s.to_str());
         if let Some(p) = parent.filter(|p| !p.is_empty()) {
             return p.to_string();
         }
@@ -110,8 +110,7 @@ pub fn parse_scene(text: &str, default_name: &str) -> Result<Scene, SceneError> 
 
 /// As [`parse_scene`], with `KEY=VALUE` overrides (see [`load_scene_with`]).
 pub fn parse_scene_with(text: &str, default_name: &str, overrides: &[String]) -> Result<Scene, SceneError> {
-    let mut table: toml::Table =
-        toml::from_str(text).map_err(|e| SceneErrorKind::Syntax(syntax_message(text, &e)))?;
+    let mut table: toml::Table = toml::from_str(text).map_err(|e| SceneErrorKind::Syntax(syntax_message(text, &e)))?;
     for o in overrides {
         apply_override(&mut table, o)?;
     }
@@ -222,12 +221,7 @@ fn missing(path: &str) -> SceneError {
 }
 
 fn not_allowed(path: &str, value: f64, allowed: String) -> SceneError {
-    SceneErrorKind::NotAllowed {
-        path: path.into(),
-        value: fmt_num(value),
-        allowed,
-    }
-    .into()
+    SceneErrorKind::NotAllowed { path: path.into(), value: fmt_num(value), allowed }.into()
 }
 
 impl Scene {
@@ -240,12 +234,7 @@ impl Scene {
         // Containment of the Hertz circle (x_min <= -1 <= 1 <= x_max, same in z, hence also
         // x_min < x_max) is a single-field range checked by the walk above; what remains is
         // the cross-field bound by the cube.
-        for (v, name) in [
-            (r.x_min, "x_min"),
-            (r.x_max, "x_max"),
-            (r.z_min, "z_min"),
-            (r.z_max, "z_max"),
-        ] {
+        for (v, name) in [(r.x_min, "x_min"), (r.x_max, "x_max"), (r.z_min, "z_min"), (r.z_max, "z_max")] {
             if v.abs() >= half {
                 return Err(not_allowed(
                     &format!("reynolds.{name}"),
@@ -331,7 +320,11 @@ impl Scene {
                 None
             };
             if let Some(why) = why {
-                return Err(SceneErrorKind::Conflict(format!("accuracy.target = {} is not supported here: {why} (remove accuracy.target or set it to 0)", self.accuracy.target)).into());
+                return Err(SceneErrorKind::Conflict(format!(
+                    "accuracy.target = {} is not supported here: {why} (remove accuracy.target or set it to 0)",
+                    self.accuracy.target
+                ))
+                .into());
             }
         }
         if let Some(sw) = &self.sweep {
@@ -417,17 +410,23 @@ impl Scene {
         if e.surface_traction == SurfaceTraction::Friction && !self.output.subsurface {
             w.push("effects.surface_traction = \"friction\" only loads the subsurface stress field, which output.subsurface = false does not compute".into());
         }
-        if self.operating.friction_coefficient > 0.0 && (e.lubrication == LubricationModel::Reynolds || e.surface_traction == SurfaceTraction::Off) {
+        if self.operating.friction_coefficient > 0.0
+            && (e.lubrication == LubricationModel::Reynolds || e.surface_traction == SurfaceTraction::Off)
+        {
             w.push("operating.friction_coefficient is only used by a dry scene with effects.surface_traction = \"friction\" (a lubricated scene takes its traction from the friction pass)".into());
         }
         if e.lubrication == LubricationModel::Dry {
             if e.friction != FrictionModel::Off {
-                w.push(format!("effects.friction = \"{}\" has no effect with effects.lubrication = \"none\" (no film, no shear pass)", e.friction));
+                w.push(format!(
+                    "effects.friction = \"{}\" has no effect with effects.lubrication = \"none\" (no film, no shear pass)",
+                    e.friction
+                ));
             }
             return w;
         }
         let srr_swept = self.sweep.as_ref().is_some_and(|s| s.slide_to_roll.is_some());
-        if e.friction != FrictionModel::Off && e.kinematics == KinematicsModel::Uniform && self.operating.slide_to_roll == 0.0 && !srr_swept {
+        if e.friction != FrictionModel::Off && e.kinematics == KinematicsModel::Uniform && self.operating.slide_to_roll == 0.0 && !srr_swept
+        {
             w.push(format!(
                 "effects.friction = \"{}\" with effects.kinematics = \"uniform\" and operating.slide_to_roll = 0: there is no sliding, the shear pass only sees the pressure-gradient (Poiseuille) stresses",
                 e.friction
@@ -439,7 +438,10 @@ impl Scene {
             }
         }
         if e.kinematics == KinematicsModel::Uniform && self.operating.tilt_angle != 90.0 {
-            w.push(format!("operating.tilt_angle = {} deg is ignored by effects.kinematics = \"uniform\" (no spin)", fmt_num(self.operating.tilt_angle)));
+            w.push(format!(
+                "operating.tilt_angle = {} deg is ignored by effects.kinematics = \"uniform\" (no spin)",
+                fmt_num(self.operating.tilt_angle)
+            ));
         }
         w
     }
@@ -473,13 +475,7 @@ impl Scene {
                 self.geometry.ball_radius,
                 self.geometry.disc_track_radius,
             )
-            .map_err(|err| {
-                not_allowed(
-                    "operating.tilt_angle",
-                    self.operating.tilt_angle,
-                    err.to_string(),
-                )
-            })?;
+            .map_err(|err| not_allowed("operating.tilt_angle", self.operating.tilt_angle, err.to_string()))?;
         }
         Ok(())
     }
@@ -487,13 +483,10 @@ impl Scene {
     /// Re-checks single-field ranges (already done while parsing a file) so that scenes
     /// built in code get the same guarantees.
     fn validate_fields_finite(&self) -> Result<(), SceneError> {
-        let value = toml::Value::try_from(self).map_err(|e| {
-            SceneErrorKind::Conflict(format!("scene cannot be represented as TOML: {e}"))
-        })?;
+        let value =
+            toml::Value::try_from(self).map_err(|e| SceneErrorKind::Conflict(format!("scene cannot be represented as TOML: {e}")))?;
         match value {
-            toml::Value::Table(t) => {
-                spec::check_table(SCENE_FIELDS, &t, SCENE_FIELDS, "").map_err(Into::into)
-            }
+            toml::Value::Table(t) => spec::check_table(SCENE_FIELDS, &t, SCENE_FIELDS, "").map_err(Into::into),
             _ => unreachable!("a struct serialises to a table"),
         }
     }
@@ -517,12 +510,7 @@ impl Scene {
 
     /// Dry Hertz solution (a, p_H, E') for the scene's load, ball radius and materials.
     pub fn hertz(&self) -> Hertz {
-        Hertz::new(
-            self.operating.load,
-            self.geometry.ball_radius,
-            self.ball_material(),
-            self.disc_material(),
-        )
+        Hertz::new(self.operating.load, self.geometry.ball_radius, self.ball_material(), self.disc_material())
     }
 
     /// Material of the equivalent elastic solid (docs/model.md section 6).
@@ -539,16 +527,8 @@ impl Scene {
         let alpha = l.pressure_viscosity.unwrap_or(0.0);
         Ok(match self.effects.viscosity {
             ViscosityModel::Constant => ViscosityLaw::Constant { eta_r: l.viscosity },
-            ViscosityModel::Barus => ViscosityLaw::Barus {
-                eta_r: l.viscosity,
-                alpha,
-            },
-            ViscosityModel::Roelands => ViscosityLaw::roelands(
-                l.viscosity,
-                alpha,
-                l.roelands_reference_pressure,
-                l.roelands_exponent,
-            )?,
+            ViscosityModel::Barus => ViscosityLaw::Barus { eta_r: l.viscosity, alpha },
+            ViscosityModel::Roelands => ViscosityLaw::roelands(l.viscosity, alpha, l.roelands_reference_pressure, l.roelands_exponent)?,
         })
     }
 
@@ -577,11 +557,7 @@ impl Scene {
     /// speed (dry scenes).
     pub fn kinematics(&self) -> Option<Kinematics> {
         let ue = self.operating.entrainment_speed?;
-        let (srr, rb, rd) = (
-            self.operating.slide_to_roll,
-            self.geometry.ball_radius,
-            self.geometry.disc_track_radius,
-        );
+        let (srr, rb, rd) = (self.operating.slide_to_roll, self.geometry.ball_radius, self.geometry.disc_track_radius);
         Some(
             match self.effects.kinematics {
                 KinematicsModel::Spin => Kinematics::new(ue, srr, self.tilt_angle_rad(), rb, rd),
@@ -595,10 +571,7 @@ impl Scene {
     /// if given, else d ln eta/dp at p = 0 of the viscosity law.
     pub fn effective_alpha(&self) -> Option<f64> {
         let l = self.lubricant.as_ref()?;
-        l.pressure_viscosity.or_else(|| {
-            self.viscosity_law()
-                .map(|v| v.pressure_viscosity_at_ambient())
-        })
+        l.pressure_viscosity.or_else(|| self.viscosity_law().map(|v| v.pressure_viscosity_at_ambient()))
     }
 
     /// Moes / Hamrock-Dowson dimensionless groups, when lubricated.
@@ -606,14 +579,7 @@ impl Scene {
         let l = self.lubricant.as_ref()?;
         let ue = self.operating.entrainment_speed?;
         let h = self.hertz();
-        Some(MoesParameters::new(
-            h.load,
-            ue,
-            l.viscosity,
-            self.effective_alpha()?,
-            h.e_prime,
-            h.radius,
-        ))
+        Some(MoesParameters::new(h.load, ue, l.viscosity, self.effective_alpha()?, h.e_prime, h.radius))
     }
 
     /// Hamrock-Dowson reference films for this operating point (k = 1), when lubricated.
@@ -621,14 +587,7 @@ impl Scene {
         let l = self.lubricant.as_ref()?;
         let ue = self.operating.entrainment_speed?;
         let h = self.hertz();
-        Some(HamrockDowson::circular(
-            h.load,
-            ue,
-            l.viscosity,
-            self.effective_alpha()?,
-            h.e_prime,
-            h.radius,
-        ))
+        Some(HamrockDowson::circular(h.load, ue, l.viscosity, self.effective_alpha()?, h.e_prime, h.radius))
     }
 }
 

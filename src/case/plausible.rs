@@ -228,7 +228,8 @@ fn quantities(s: &Scene, memory: Option<f64>) -> Vec<Quantity> {
             // wide: the finest element must not be coarser than about a hundred of them.
             let width = hc * r / (h.a * h.a);
             let m = &s.mesh;
-            let finest = [m.contact_size, m.core_size, m.ring_size, m.patch_size].into_iter().filter(|&v| v > 0.0).fold(f64::INFINITY, f64::min);
+            let finest =
+                [m.contact_size, m.core_size, m.ring_size, m.patch_size].into_iter().filter(|&v| v > 0.0).fold(f64::INFINITY, f64::min);
             q.push(Quantity {
                 name: "film_vs_mesh",
                 what: format!("finest element size over the film width hc R/a^2 (= {})", fmt_num(width)),
@@ -349,7 +350,9 @@ impl Scene {
         let n = sweep_point_count(self);
         let (hard_n, soft_n) = MAX_SWEEP_POINTS;
         if n > hard_n as f64 {
-            return Err(err(format!("[sweep] asks for {n:.0} operating points (the product of its list lengths); at most {hard_n} are allowed")));
+            return Err(err(format!(
+                "[sweep] asks for {n:.0} operating points (the product of its list lengths); at most {hard_n} are allowed"
+            )));
         }
         if n > soft_n as f64 {
             let msg = format!("[sweep] asks for {n:.0} operating points (the product of its list lengths), more than {soft_n}");
@@ -386,7 +389,14 @@ impl Scene {
                     )));
                 }
                 if !inside(q.value, q.soft) {
-                    let msg = format!("{} = {}{point} is outside {} ({}); it comes from {}", q.what, fmt_num(q.value), range_text(q.soft), q.why, q.from);
+                    let msg = format!(
+                        "{} = {}{point} is outside {} ({}); it comes from {}",
+                        q.what,
+                        fmt_num(q.value),
+                        range_text(q.soft),
+                        q.why,
+                        q.from
+                    );
                     if !accepted(q.name) {
                         return Err(err(format!("{msg}; add \"{}\" to checks.accept if this is intended", q.name)));
                     }
@@ -428,7 +438,8 @@ mod tests {
         let mut bad = Vec::new();
         for (name, s) in shipped() {
             for p in s.check_points() {
-                let line: Vec<String> = quantities(&p, Some(f64::INFINITY)).iter().map(|q| format!("{} {}", q.name, fmt_num(q.value))).collect();
+                let line: Vec<String> =
+                    quantities(&p, Some(f64::INFINITY)).iter().map(|q| format!("{} {}", q.name, fmt_num(q.value))).collect();
                 eprintln!("{name}: {}", line.join(", "));
             }
             match s.plausibility() {

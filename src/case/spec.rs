@@ -160,10 +160,7 @@ pub fn fmt_num(v: f64) -> String {
 }
 
 fn quoted_list(c: &[&str]) -> String {
-    c.iter()
-        .map(|s| format!("\"{s}\""))
-        .collect::<Vec<_>>()
-        .join(", ")
+    c.iter().map(|s| format!("\"{s}\"")).collect::<Vec<_>>().join(", ")
 }
 
 fn join(prefix: &str, key: &str) -> String {
@@ -244,27 +241,16 @@ pub fn lookup(root: &'static [Field], path: &str) -> Option<&'static Field> {
 
 /// Walks `table` against `fields`: unknown keys, wrong types, non-finite or out-of-range
 /// numbers, unknown choices, empty strings and missing required keys.
-pub fn check_table(
-    root: &'static [Field],
-    table: &Table,
-    fields: &'static [Field],
-    prefix: &str,
-) -> Result<(), SceneErrorKind> {
+pub fn check_table(root: &'static [Field], table: &Table, fields: &'static [Field], prefix: &str) -> Result<(), SceneErrorKind> {
     for (key, value) in table {
         let path = join(prefix, key);
         let Some(field) = fields.iter().find(|f| f.key == key.as_str()) else {
-            let suggestion = closest(key, fields.iter().map(|f| f.key))
-                .map(str::to_string)
-                .or_else(|| {
-                    let mut elsewhere = Vec::new();
-                    find_elsewhere(root, key, "", &mut elsewhere);
-                    (elsewhere.len() == 1).then(|| elsewhere.remove(0))
-                });
-            return Err(SceneErrorKind::UnknownKey {
-                path,
-                suggestion,
-                known: fields.iter().map(|f| f.key).collect(),
+            let suggestion = closest(key, fields.iter().map(|f| f.key)).map(str::to_string).or_else(|| {
+                let mut elsewhere = Vec::new();
+                find_elsewhere(root, key, "", &mut elsewhere);
+                (elsewhere.len() == 1).then(|| elsewhere.remove(0))
             });
+            return Err(SceneErrorKind::UnknownKey { path, suggestion, known: fields.iter().map(|f| f.key).collect() });
         };
         check_value(root, field, value, &path)?;
     }
@@ -281,28 +267,13 @@ pub fn check_table(
     Ok(())
 }
 
-fn check_value(
-    root: &'static [Field],
-    field: &Field,
-    value: &Value,
-    path: &str,
-) -> Result<(), SceneErrorKind> {
-    let wrong = || SceneErrorKind::WrongType {
-        path: path.to_string(),
-        expected: field.expected(),
-        found: describe_value(value),
-    };
-    let not_allowed = |shown: String, allowed: String| SceneErrorKind::NotAllowed {
-        path: path.to_string(),
-        value: shown,
-        allowed,
-    };
+fn check_value(root: &'static [Field], field: &Field, value: &Value, path: &str) -> Result<(), SceneErrorKind> {
+    let wrong = || SceneErrorKind::WrongType { path: path.to_string(), expected: field.expected(), found: describe_value(value) };
+    let not_allowed = |shown: String, allowed: String| SceneErrorKind::NotAllowed { path: path.to_string(), value: shown, allowed };
     match field.kind {
         Kind::Number(range) => check_number(field, range, value, path)?,
         Kind::NumberList(range) => match value {
-            Value::Array(items) if items.is_empty() => {
-                return Err(not_allowed("[]".into(), "must be a non-empty array of numbers".into()))
-            }
+            Value::Array(items) if items.is_empty() => return Err(not_allowed("[]".into(), "must be a non-empty array of numbers".into())),
             Value::Array(items) => {
                 for (i, item) in items.iter().enumerate() {
                     check_number(field, range, item, &format!("{path}[{i}]"))?;
@@ -316,25 +287,15 @@ fn check_value(
             }
         }
         Kind::Text => match value {
-            Value::String(s) if s.trim().is_empty() => {
-                return Err(not_allowed(
-                    format!("\"{s}\""),
-                    "must be a non-empty string".into(),
-                ))
-            }
+            Value::String(s) if s.trim().is_empty() => return Err(not_allowed(format!("\"{s}\""), "must be a non-empty string".into())),
             Value::String(_) => {}
             _ => return Err(wrong()),
         },
         Kind::Choice(choices) => match value {
             Value::String(s) if choices.contains(&s.as_str()) => {}
             Value::String(s) => {
-                let hint = closest(s, choices.iter().copied())
-                    .map(|c| format!(" (did you mean \"{c}\"?)"))
-                    .unwrap_or_default();
-                return Err(not_allowed(
-                    format!("\"{s}\""),
-                    format!("must be one of {}{hint}", quoted_list(choices)),
-                ));
+                let hint = closest(s, choices.iter().copied()).map(|c| format!(" (did you mean \"{c}\"?)")).unwrap_or_default();
+                return Err(not_allowed(format!("\"{s}\""), format!("must be one of {}{hint}", quoted_list(choices))));
             }
             _ => return Err(wrong()),
         },
@@ -345,12 +306,20 @@ fn check_value(
                     match item {
                         Value::String(s) if choices.contains(&s.as_str()) => {
                             if items[..i].contains(item) {
-                                return Err(SceneErrorKind::NotAllowed { path: p, value: format!("\"{s}\""), allowed: "is listed twice".into() });
+                                return Err(SceneErrorKind::NotAllowed {
+                                    path: p,
+                                    value: format!("\"{s}\""),
+                                    allowed: "is listed twice".into(),
+                                });
                             }
                         }
                         Value::String(s) => {
                             let hint = closest(s, choices.iter().copied()).map(|c| format!(" (did you mean \"{c}\"?)")).unwrap_or_default();
-                            return Err(SceneErrorKind::NotAllowed { path: p, value: format!("\"{s}\""), allowed: format!("must be one of {}{hint}", quoted_list(choices)) });
+                            return Err(SceneErrorKind::NotAllowed {
+                                path: p,
+                                value: format!("\"{s}\""),
+                                allowed: format!("must be one of {}{hint}", quoted_list(choices)),
+                            });
                         }
                         _ => return Err(SceneErrorKind::WrongType { path: p, expected: field.expected(), found: describe_value(item) }),
                     }
@@ -371,13 +340,7 @@ fn check_number(field: &Field, range: Range, value: &Value, path: &str) -> Resul
     let (v, shown) = match value {
         Value::Integer(i) => (*i as f64, i.to_string()),
         Value::Float(x) => (*x, fmt_num(*x)),
-        _ => {
-            return Err(SceneErrorKind::WrongType {
-                path: path.to_string(),
-                expected: field.expected(),
-                found: describe_value(value),
-            })
-        }
+        _ => return Err(SceneErrorKind::WrongType { path: path.to_string(), expected: field.expected(), found: describe_value(value) }),
     };
     let not_allowed = |allowed: String| SceneErrorKind::NotAllowed { path: path.to_string(), value: shown.clone(), allowed };
     if !v.is_finite() {
@@ -399,23 +362,10 @@ pub fn reference_markdown(root: &'static [Field]) -> String {
     out
 }
 
-fn write_section(
-    out: &mut String,
-    fields: &'static [Field],
-    prefix: &str,
-    what: &str,
-    presence: &str,
-) {
-    let title = if prefix.is_empty() {
-        "top level".to_string()
-    } else {
-        format!("[{prefix}]")
-    };
+fn write_section(out: &mut String, fields: &'static [Field], prefix: &str, what: &str, presence: &str) {
+    let title = if prefix.is_empty() { "top level".to_string() } else { format!("[{prefix}]") };
     out.push_str(&format!("## {title}\n\n{what}{presence}.\n\n"));
-    let leaves: Vec<&Field> = fields
-        .iter()
-        .filter(|f| !matches!(f.kind, Kind::Table(_)))
-        .collect();
+    let leaves: Vec<&Field> = fields.iter().filter(|f| !matches!(f.kind, Kind::Table(_))).collect();
     if !leaves.is_empty() {
         out.push_str("| key | meaning | unit | allowed | default |\n|---|---|---|---|---|\n");
         for f in leaves {
@@ -428,11 +378,7 @@ fn write_section(
                 Kind::ChoiceList(c) => format!("array of {}", quoted_list(c)),
                 Kind::Table(_) => unreachable!(),
             };
-            let note = if f.note.is_empty() {
-                String::new()
-            } else {
-                format!(" ({})", f.note)
-            };
+            let note = if f.note.is_empty() { String::new() } else { format!(" ({})", f.note) };
             let unit = if f.unit.is_empty() { "-" } else { f.unit };
             out.push_str(&format!(
                 "| `{}` | {} | {} | {} | {} |\n",
@@ -479,10 +425,7 @@ mod tests {
         assert_eq!(edit_distance("kitten", "sitting"), 3);
         assert_eq!(edit_distance("", "abc"), 3);
         assert_eq!(closest("lod", ["load", "entrainment_speed"]), Some("load"));
-        assert_eq!(
-            closest("ball_raduis", ["ball_radius", "disc_track_radius"]),
-            Some("ball_radius")
-        );
+        assert_eq!(closest("ball_raduis", ["ball_radius", "disc_track_radius"]), Some("ball_radius"));
         assert_eq!(closest("zzzzzz", ["load", "tilt_angle"]), None);
     }
 

@@ -97,11 +97,7 @@ fn err(text: &str) -> String {
 
 /// PAPER_SPIN with `old` replaced by `new` (which must occur exactly once).
 fn paper_with(old: &str, new: &str) -> String {
-    assert_eq!(
-        PAPER_SPIN.matches(old).count(),
-        1,
-        "'{old}' must occur once"
-    );
+    assert_eq!(PAPER_SPIN.matches(old).count(), 1, "'{old}' must occur once");
     PAPER_SPIN.replace(old, new)
 }
 
@@ -163,59 +159,33 @@ fn known_keys_match_structs() {
     fn all_present(fields: &'static [Field], t: &toml::Table, prefix: &str) {
         for f in fields {
             let path = format!("{prefix}{}", f.key);
-            let v = t
-                .get(f.key)
-                .unwrap_or_else(|| panic!("schema key '{path}' missing from the serialised scene"));
+            let v = t.get(f.key).unwrap_or_else(|| panic!("schema key '{path}' missing from the serialised scene"));
             if let Kind::Table(sub) = f.kind {
                 all_present(sub, v.as_table().expect("table"), &format!("{path}."));
             }
         }
     }
     let s = parse_scene(PAPER_SPIN, "x").unwrap();
-    let toml::Value::Table(t) = toml::Value::try_from(&s).unwrap() else {
-        panic!()
-    };
+    let toml::Value::Table(t) = toml::Value::try_from(&s).unwrap() else { panic!() };
     all_present(SCENE_FIELDS, &t, "");
     spec::check_table(SCENE_FIELDS, &t, SCENE_FIELDS, "").unwrap();
     // And the count of serialised keys equals the count of schema keys at every level.
     fn count_fields(fields: &'static [Field]) -> usize {
-        fields
-            .iter()
-            .map(|f| {
-                1 + if let Kind::Table(s) = f.kind {
-                    count_fields(s)
-                } else {
-                    0
-                }
-            })
-            .sum()
+        fields.iter().map(|f| 1 + if let Kind::Table(s) = f.kind { count_fields(s) } else { 0 }).sum()
     }
     fn count_value(t: &toml::Table) -> usize {
-        t.values()
-            .map(|v| 1 + v.as_table().map_or(0, count_value))
-            .sum()
+        t.values().map(|v| 1 + v.as_table().map_or(0, count_value)).sum()
     }
     assert_eq!(count_fields(SCENE_FIELDS), count_value(&t));
 }
 
 #[test]
 fn choice_names_match_serde() {
-    fn check<
-        T: serde::Serialize + serde::de::DeserializeOwned + PartialEq + std::fmt::Debug + Copy,
-    >(
-        all: &[T],
-        names: &[&str],
-    ) {
+    fn check<T: serde::Serialize + serde::de::DeserializeOwned + PartialEq + std::fmt::Debug + Copy>(all: &[T], names: &[&str]) {
         assert_eq!(all.len(), names.len());
         for (v, n) in all.iter().zip(names) {
-            assert_eq!(
-                serde_json::to_value(v).unwrap(),
-                serde_json::Value::String(n.to_string())
-            );
-            assert_eq!(
-                serde_json::from_value::<T>(serde_json::Value::String(n.to_string())).unwrap(),
-                *v
-            );
+            assert_eq!(serde_json::to_value(v).unwrap(), serde_json::Value::String(n.to_string()));
+            assert_eq!(serde_json::from_value::<T>(serde_json::Value::String(n.to_string())).unwrap(), *v);
         }
     }
     check(LubricationModel::ALL, LubricationModel::NAMES);
@@ -235,11 +205,7 @@ fn choice_names_match_serde() {
 fn physics_helpers() {
     let s = parse_scene(PAPER_SPIN, "x").unwrap();
     let h = s.hertz();
-    assert!(
-        rel(h.a, 0.92052e-3) < 1e-4
-            && rel(h.ph, 0.84522e9) < 1e-4
-            && rel(h.e_prime, 230.77e9) < 1e-4
-    );
+    assert!(rel(h.a, 0.92052e-3) < 1e-4 && rel(h.ph, 0.84522e9) < 1e-4 && rel(h.e_prime, 230.77e9) < 1e-4);
     let eq = s.equivalent_solid();
     assert!(rel(eq.e, 105e9) < 1e-12 && rel(eq.nu, 0.3) < 1e-12);
     let k = s.kinematics().unwrap();
@@ -275,13 +241,7 @@ fn physics_helpers() {
 
 #[test]
 fn contact_size_rounding() {
-    let m = |c| {
-        MeshSettings {
-            contact_size: c,
-            ..MeshSettings::default()
-        }
-        .contact_size_rounded()
-    };
+    let m = |c| MeshSettings { contact_size: c, ..MeshSettings::default() }.contact_size_rounded();
     assert_eq!(m(0.25), 0.25);
     assert_eq!(m(0.3), 0.25);
     assert_eq!(m(0.2), 0.125);
@@ -292,15 +252,7 @@ fn contact_size_rounding() {
 #[test]
 fn reference_lists_every_key() {
     let md = reference_markdown();
-    for key in [
-        "ball_radius",
-        "poisson_ratio",
-        "roelands_exponent",
-        "tilt_angle",
-        "stabilisation",
-        "growth",
-        "png",
-    ] {
+    for key in ["ball_radius", "poisson_ratio", "roelands_exponent", "tilt_angle", "stabilisation", "growth", "png"] {
         assert!(md.contains(&format!("`{key}`")), "{key} missing from\n{md}");
     }
     assert!(md.contains("## [materials.ball]") && md.contains("## [effects]"));
@@ -316,36 +268,21 @@ fn reference_lists_every_key() {
 #[test]
 fn missing_field() {
     let e = err(&paper_with("ball_radius = 0.08\n", ""));
-    assert_eq!(
-        e,
-        "missing field 'geometry.ball_radius' (ball radius R_B in m, > 0)"
-    );
+    assert_eq!(e, "missing field 'geometry.ball_radius' (ball radius R_B in m, > 0)");
     let e = err(&paper_with("[operating]\nload = 1500.0\n", "[operating]\n"));
-    assert_eq!(
-        e,
-        "missing field 'operating.load' (normal load L in N, > 0)"
-    );
+    assert_eq!(e, "missing field 'operating.load' (normal load L in N, > 0)");
 }
 
 #[test]
 fn missing_section() {
-    let text = PAPER_SPIN.replace(
-        "[materials.disc]\nyoung_modulus = 210e9\npoisson_ratio = 0.3\n",
-        "",
-    );
-    assert_eq!(
-        err(&text),
-        "missing section '[materials.disc]' (elastic material of the disc D)"
-    );
+    let text = PAPER_SPIN.replace("[materials.disc]\nyoung_modulus = 210e9\npoisson_ratio = 0.3\n", "");
+    assert_eq!(err(&text), "missing section '[materials.disc]' (elastic material of the disc D)");
 }
 
 #[test]
 fn negative_radius() {
     let e = err(&paper_with("ball_radius = 0.08", "ball_radius = -0.08"));
-    assert_eq!(
-        e,
-        "geometry.ball_radius = -0.08 is not allowed: must be > 0 (m)"
-    );
+    assert_eq!(e, "geometry.ball_radius = -0.08 is not allowed: must be > 0 (m)");
 }
 
 #[test]
@@ -354,10 +291,7 @@ fn poisson_ratio_half() {
         "[materials.ball]\nyoung_modulus = 210e9\npoisson_ratio = 0.3",
         "[materials.ball]\nyoung_modulus = 210e9\npoisson_ratio = 0.5",
     ));
-    assert_eq!(
-        e,
-        "materials.ball.poisson_ratio = 0.5 is not allowed: must be in (-1, 0.5)"
-    );
+    assert_eq!(e, "materials.ball.poisson_ratio = 0.5 is not allowed: must be in (-1, 0.5)");
 }
 
 #[test]
@@ -367,20 +301,11 @@ fn unknown_key_with_suggestion() {
     let e = err(&paper_with("[geometry]", "[geometri]"));
     assert_eq!(e, "unknown key 'geometri' (did you mean 'geometry'?)");
     // A key written in the wrong section points to where it belongs.
-    let e = err(&paper_with(
-        "disc_track_radius = 0.04\n",
-        "disc_track_radius = 0.04\nload = 3.0\n",
-    ));
-    assert_eq!(
-        e,
-        "unknown key 'geometry.load' (did you mean 'operating.load'?)"
-    );
+    let e = err(&paper_with("disc_track_radius = 0.04\n", "disc_track_radius = 0.04\nload = 3.0\n"));
+    assert_eq!(e, "unknown key 'geometry.load' (did you mean 'operating.load'?)");
     // Nothing close: list the known keys.
     let e = err(&paper_with("png = false", "png = false\ncolour = true"));
-    assert_eq!(
-        e,
-        "unknown key 'output.colour' (known keys here: dir, vtu, png, shear_profile_z, subsurface, subsurface_recovery)"
-    );
+    assert_eq!(e, "unknown key 'output.colour' (known keys here: dir, vtu, png, shear_profile_z, subsurface, subsurface_recovery)");
 }
 
 #[test]
@@ -388,37 +313,19 @@ fn wrong_type() {
     let e = err(&paper_with("load = 1500.0", "load = \"1500\""));
     assert_eq!(e, "operating.load has the wrong type: expected a number (normal load L in N, > 0), found the string \"1500\"");
     let e = err(&paper_with("vtu = true", "vtu = 1"));
-    assert!(
-        e.starts_with("output.vtu has the wrong type: expected a boolean"),
-        "{e}"
-    );
+    assert!(e.starts_with("output.vtu has the wrong type: expected a boolean"), "{e}");
     let e = err(&paper_with("stabilisation = \"supg\"", "stabilisation = 1"));
-    assert!(
-        e.starts_with("reynolds.stabilisation has the wrong type: expected a string"),
-        "{e}"
-    );
-    let e = err(&format!(
-        "geometry = 1\n{}",
-        DRY_HERTZ.replace("[geometry]\nball_radius = 0.08\n", "")
-    ));
-    assert!(
-        e.starts_with("geometry has the wrong type: expected a table"),
-        "{e}"
-    );
+    assert!(e.starts_with("reynolds.stabilisation has the wrong type: expected a string"), "{e}");
+    let e = err(&format!("geometry = 1\n{}", DRY_HERTZ.replace("[geometry]\nball_radius = 0.08\n", "")));
+    assert!(e.starts_with("geometry has the wrong type: expected a table"), "{e}");
 }
 
 #[test]
 fn non_finite() {
     let e = err(&paper_with("load = 1500.0", "load = inf"));
-    assert_eq!(
-        e,
-        "operating.load = inf is not allowed: must be a finite number"
-    );
+    assert_eq!(e, "operating.load = inf is not allowed: must be a finite number");
     let e = err(&paper_with("viscosity = 0.012", "viscosity = nan"));
-    assert_eq!(
-        e,
-        "lubricant.viscosity = NaN is not allowed: must be a finite number"
-    );
+    assert_eq!(e, "lubricant.viscosity = NaN is not allowed: must be a finite number");
 }
 
 #[test]
@@ -426,45 +333,32 @@ fn zero_tilt_angle() {
     let e = err(&paper_with("tilt_angle = 2.0", "tilt_angle = 0"));
     assert!(e.starts_with("operating.tilt_angle = 0 is not allowed: must be in (0, 90] (degrees); lambda = 0 is singular"), "{e}");
     let e = err(&paper_with("tilt_angle = 2.0", "tilt_angle = 91"));
-    assert!(
-        e.starts_with("operating.tilt_angle = 91 is not allowed: must be in (0, 90]"),
-        "{e}"
-    );
+    assert!(e.starts_with("operating.tilt_angle = 91 is not allowed: must be in (0, 90]"), "{e}");
 }
 
 #[test]
 fn bad_choice() {
-    let e = err(&paper_with(
-        "viscosity = \"roelands\"",
-        "viscosity = \"roeland\"",
-    ));
-    assert_eq!(e, "effects.viscosity = \"roeland\" is not allowed: must be one of \"roelands\", \"barus\", \"constant\" (did you mean \"roelands\"?)");
+    let e = err(&paper_with("viscosity = \"roelands\"", "viscosity = \"roeland\""));
+    assert_eq!(
+        e,
+        "effects.viscosity = \"roeland\" is not allowed: must be one of \"roelands\", \"barus\", \"constant\" (did you mean \"roelands\"?)"
+    );
 }
 
 #[test]
 fn other_ranges() {
-    assert!(
-        err(&paper_with("slide_to_roll = 0.05", "slide_to_roll = -2.5"))
-            .starts_with("operating.slide_to_roll = -2.5 is not allowed")
-    );
-    assert!(err(&paper_with("cube_size = 60.0", "cube_size = 10"))
-        .starts_with("mesh.cube_size = 10 is not allowed: must be in [20, 200]"));
-    assert!(err(&paper_with("growth = 0.5", "growth = 0"))
-        .starts_with("mesh.growth = 0 is not allowed: must be in (0, 2]"));
+    assert!(err(&paper_with("slide_to_roll = 0.05", "slide_to_roll = -2.5")).starts_with("operating.slide_to_roll = -2.5 is not allowed"));
+    assert!(err(&paper_with("cube_size = 60.0", "cube_size = 10")).starts_with("mesh.cube_size = 10 is not allowed: must be in [20, 200]"));
+    assert!(err(&paper_with("growth = 0.5", "growth = 0")).starts_with("mesh.growth = 0 is not allowed: must be in (0, 2]"));
     assert!(err(&paper_with(
         "young_modulus = 210e9\npoisson_ratio = 0.3\n\n[lubricant]",
         "young_modulus = 0\npoisson_ratio = 0.3\n\n[lubricant]"
     ))
     .starts_with("materials.disc.young_modulus = 0 is not allowed: must be > 0 (Pa)"));
-    assert!(
-        err(&paper_with("dir = \"out/paper-spin-2deg\"", "dir = \"\""))
-            .starts_with("output.dir = \"\" is not allowed: must be a non-empty string")
-    );
-    assert!(err(&paper_with(
-        "pressure_viscosity = 23e-9",
-        "pressure_viscosity = -1e-9"
-    ))
-    .starts_with("lubricant.pressure_viscosity = -1e-9 is not allowed: must be >= 0"));
+    assert!(err(&paper_with("dir = \"out/paper-spin-2deg\"", "dir = \"\""))
+        .starts_with("output.dir = \"\" is not allowed: must be a non-empty string"));
+    assert!(err(&paper_with("pressure_viscosity = 23e-9", "pressure_viscosity = -1e-9"))
+        .starts_with("lubricant.pressure_viscosity = -1e-9 is not allowed: must be >= 0"));
 }
 
 #[test]
@@ -472,15 +366,9 @@ fn reynolds_box_must_contain_hertz_circle() {
     let e = err(&paper_with("x_min = -3.0", "x_min = -0.5"));
     assert_eq!(e, "reynolds.x_min = -0.5 is not allowed: must be <= -1 (a); the rectangle must contain the Hertz circle and lie inside the top face: |x_min| < mesh.cube_size/2");
     let e = err(&paper_with("z_max = 3.0", "z_max = 0.9"));
-    assert!(
-        e.starts_with("reynolds.z_max = 0.9 is not allowed: must be >= 1"),
-        "{e}"
-    );
+    assert!(e.starts_with("reynolds.z_max = 0.9 is not allowed: must be >= 1"), "{e}");
     let e = err(&paper_with("x_min = -3.0", "x_min = 4.0"));
-    assert!(
-        e.starts_with("reynolds.x_min = 4 is not allowed: must be <= -1 (a)"),
-        "{e}"
-    );
+    assert!(e.starts_with("reynolds.x_min = 4 is not allowed: must be <= -1 (a)"), "{e}");
     // The cross-field pass gives the same message for scenes built in code.
     let mut s = parse_scene(PAPER_SPIN, "x").unwrap();
     s.reynolds.z_min = -0.25;
@@ -493,54 +381,34 @@ fn reynolds_box_must_contain_hertz_circle() {
 #[test]
 fn reynolds_box_must_fit_the_cube() {
     let e = err(&paper_with("x_max = 3.0", "x_max = 30.0"));
-    assert!(
-        e.starts_with(
-            "reynolds.x_max = 30 is not allowed: |x_max| must be < mesh.cube_size/2 = 30"
-        ),
-        "{e}"
-    );
+    assert!(e.starts_with("reynolds.x_max = 30 is not allowed: |x_max| must be < mesh.cube_size/2 = 30"), "{e}");
 }
 
 #[test]
 fn roelands_exponent_needs_roelands() {
-    let e = err(&paper_with(
-        "viscosity = \"roelands\"",
-        "viscosity = \"barus\"",
-    ));
-    assert!(
-        e.starts_with("lubricant.roelands_exponent is given but effects.viscosity = \"barus\""),
-        "{e}"
-    );
+    let e = err(&paper_with("viscosity = \"roelands\"", "viscosity = \"barus\""));
+    assert!(e.starts_with("lubricant.roelands_exponent is given but effects.viscosity = \"barus\""), "{e}");
     // Without the exponent, Barus is fine.
-    parse_scene(
-        &paper_with("viscosity = \"roelands\"", "viscosity = \"barus\"")
-            .replace("roelands_exponent = 0.8591\n", ""),
-        "x",
-    )
-    .unwrap();
+    parse_scene(&paper_with("viscosity = \"roelands\"", "viscosity = \"barus\"").replace("roelands_exponent = 0.8591\n", ""), "x").unwrap();
 }
 
 #[test]
 fn lubricated_scene_needs_lubricant_and_speed() {
     let no_lub = DRY_HERTZ.replace("lubrication = \"none\"", "lubrication = \"reynolds\"");
-    assert_eq!(
-        err(&no_lub),
-        "missing section '[lubricant]' (lubricant properties; required when effects.lubrication = \"reynolds\")"
-    );
+    assert_eq!(err(&no_lub), "missing section '[lubricant]' (lubricant properties; required when effects.lubrication = \"reynolds\")");
     let e = err(&paper_with("entrainment_speed = 3.0\n", ""));
-    assert_eq!(e, "missing field 'operating.entrainment_speed' (entrainment speed Ue in m/s, > 0; required when effects.lubrication = \"reynolds\")");
-    let e = err(&PAPER_SPIN
-        .replace("pressure_viscosity = 23e-9\n", "")
-        .replace("roelands_exponent = 0.8591\n", ""));
-    assert!(e.starts_with("missing field 'lubricant.pressure_viscosity' (pressure-viscosity coefficient alpha in 1/Pa, >= 0; required unless"), "{e}");
-    // Roelands needs eta_R above exp(-9.67).
-    let e = err(&paper_with("viscosity = 0.012", "viscosity = 1e-5"));
+    assert_eq!(
+        e,
+        "missing field 'operating.entrainment_speed' (entrainment speed Ue in m/s, > 0; required when effects.lubrication = \"reynolds\")"
+    );
+    let e = err(&PAPER_SPIN.replace("pressure_viscosity = 23e-9\n", "").replace("roelands_exponent = 0.8591\n", ""));
     assert!(
-        e.starts_with(
-            "lubricant.viscosity = 1e-5 is not allowed: with effects.viscosity = \"roelands\""
-        ),
+        e.starts_with("missing field 'lubricant.pressure_viscosity' (pressure-viscosity coefficient alpha in 1/Pa, >= 0; required unless"),
         "{e}"
     );
+    // Roelands needs eta_R above exp(-9.67).
+    let e = err(&paper_with("viscosity = 0.012", "viscosity = 1e-5"));
+    assert!(e.starts_with("lubricant.viscosity = 1e-5 is not allowed: with effects.viscosity = \"roelands\""), "{e}");
 }
 
 #[test]
@@ -557,10 +425,7 @@ fn unreadable_file() {
     let p = std::path::Path::new("/nonexistent-dir-ehl/case.toml");
     let e = load_scene(p).unwrap_err();
     let msg = e.to_string();
-    assert!(
-        msg.starts_with("cannot read scene file '/nonexistent-dir-ehl/case.toml': "),
-        "{msg}"
-    );
+    assert!(msg.starts_with("cannot read scene file '/nonexistent-dir-ehl/case.toml': "), "{msg}");
     assert!(msg.contains("No such file"), "{msg}");
     assert!(std::error::Error::source(&e).is_some());
 }
@@ -578,13 +443,7 @@ fn load_from_file_names_scene_and_errors() {
     assert_eq!(load_scene(&q).unwrap().name, "my-scene");
     std::fs::write(&q, DRY_HERTZ.replace("load = 1500", "load = -1")).unwrap();
     let msg = load_scene(&q).unwrap_err().to_string();
-    assert_eq!(
-        msg,
-        format!(
-            "{}: operating.load = -1 is not allowed: must be > 0 (N)",
-            q.display()
-        )
-    );
+    assert_eq!(msg, format!("{}: operating.load = -1 is not allowed: must be > 0 (N)", q.display()));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -592,18 +451,10 @@ fn load_from_file_names_scene_and_errors() {
 fn programmatic_scene_is_validated() {
     let mut s = parse_scene(PAPER_SPIN, "x").unwrap();
     s.operating.tilt_angle = 0.0;
-    assert!(s
-        .validate()
-        .unwrap_err()
-        .to_string()
-        .starts_with("operating.tilt_angle = 0 is not allowed"));
+    assert!(s.validate().unwrap_err().to_string().starts_with("operating.tilt_angle = 0 is not allowed"));
     let mut s = parse_scene(PAPER_SPIN, "x").unwrap();
     s.geometry.ball_radius = f64::NAN;
-    assert!(s
-        .validate()
-        .unwrap_err()
-        .to_string()
-        .contains("must be a finite number"));
+    assert!(s.validate().unwrap_err().to_string().contains("must be a finite number"));
 }
 
 #[test]
@@ -646,11 +497,23 @@ fn command_line_overrides_are_validated_like_the_file() {
     // A number, a bare word (string), a new section key.
     let e = set(&["mesh.ring_inner=1.5", "mesh.ring_outer=1.0"]).unwrap_err().to_string();
     assert_eq!(e, "mesh.ring_outer = 1 is not allowed: must exceed mesh.ring_inner = 1.5 (units of a)");
-    let e = set(&["mesh.patch_size=0.01", "mesh.patch_x_min=-0.4", "mesh.patch_x_max=0.4", "mesh.patch_z_min=-0.9", "mesh.patch_z_max=-1.0"]).unwrap_err().to_string();
+    let e =
+        set(&["mesh.patch_size=0.01", "mesh.patch_x_min=-0.4", "mesh.patch_x_max=0.4", "mesh.patch_z_min=-0.9", "mesh.patch_z_max=-1.0"])
+            .unwrap_err()
+            .to_string();
     assert_eq!(e, "mesh.patch_z_max = -1 is not allowed: must exceed mesh.patch_z_min = -0.9 (units of a) when mesh.patch_size > 0");
     // Without a patch size the rectangle is unused (its defaults are empty).
     assert!(set(&["mesh.patch_size=0"]).is_ok());
-    let e = set(&["mesh.patch_size=0.01", "mesh.patch_x_min=-0.4", "mesh.patch_x_max=0.4", "mesh.patch_z_min=-1.0", "mesh.patch_z_max=-0.9", "mesh.patch_r_min=0.97"]).unwrap_err().to_string();
+    let e = set(&[
+        "mesh.patch_size=0.01",
+        "mesh.patch_x_min=-0.4",
+        "mesh.patch_x_max=0.4",
+        "mesh.patch_z_min=-1.0",
+        "mesh.patch_z_max=-0.9",
+        "mesh.patch_r_min=0.97",
+    ])
+    .unwrap_err()
+    .to_string();
     assert_eq!(e, "mesh.patch_r_max = 0 is not allowed: must exceed mesh.patch_r_min = 0.97 (units of a) when the patch has radial limits");
     let s = set(&["operating.load=2000", "effects.friction=none", "mesh.core_size=0.0625"]).unwrap();
     assert_eq!(s.operating.load, 2000.0);
@@ -686,8 +549,10 @@ fn subsurface_keys_are_checked_together() {
     assert_eq!(s.output.subsurface_recovery, StressRecovery::Spr);
     assert_eq!(s.mesh.core_depth, 0.0);
     // A friction traction that nothing computes is a warning.
-    let s = parse_scene(&paper_with("friction = \"ree-eyring\"", "friction = \"ree-eyring\"\nsurface_traction = \"friction\""), "t").unwrap();
+    let s =
+        parse_scene(&paper_with("friction = \"ree-eyring\"", "friction = \"ree-eyring\"\nsurface_traction = \"friction\""), "t").unwrap();
     assert!(s.warnings().iter().any(|w| w.contains("output.subsurface")), "{:?}", s.warnings());
-    let s = parse_scene(&paper_with("[output]", "[output]\nsubsurface = true").replace("growth = ", "core_depth = 1.0\ngrowth = "), "t").unwrap();
+    let s = parse_scene(&paper_with("[output]", "[output]\nsubsurface = true").replace("growth = ", "core_depth = 1.0\ngrowth = "), "t")
+        .unwrap();
     assert!(s.warnings().iter().any(|w| w.contains("mesh.core_depth")), "{:?}", s.warnings());
 }

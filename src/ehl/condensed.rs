@@ -8,10 +8,10 @@
 //! (options prefix `condensed_`; ScaLAPACK's LU on 2+ ranks, LAPACK's on one; for rigid
 //! solids a sparse AIJ matrix); its size is set by the Reynolds mesh alone, not by the 3D
 //! mesh.
-use super::system::{clip_pressure_step, penalty_law, pressure_step_floor, EhlParams, Lubricant, CAVITATION_SMOOTHING};
 use super::step::{film_step_limit, FILM_COLLAPSE};
-use crate::fem::p2tri::{p2_tri_weights, tri_area};
 use super::system::EhlProblem;
+use super::system::{clip_pressure_step, penalty_law, pressure_step_floor, EhlParams, Lubricant, CAVITATION_SMOOTHING};
+use crate::fem::p2tri::{p2_tri_weights, tri_area};
 use crate::mesh::Mesh;
 use crate::petsc::snes::{Eval, Problem};
 use crate::petsc::{Matrix, Result, Vector};
@@ -160,7 +160,8 @@ impl FillBlock {
         let np = comp.cols.len();
         let all = cols.len() == total && cols.iter().enumerate().all(|(k, &c)| k == c);
         // The H0 column has no compliance: 0 in the restricted copy.
-        let c_cols = (!all && !comp.is_rigid()).then(|| comp.c.chunks_exact(np).flat_map(|crow| cols.iter().map(|&c| if c < np { crow[c] } else { 0.0 })).collect());
+        let c_cols = (!all && !comp.is_rigid())
+            .then(|| comp.c.chunks_exact(np).flat_map(|crow| cols.iter().map(|&c| if c < np { crow[c] } else { 0.0 })).collect());
         FillBlock { rows, cols, row_pos, col_pos, c_cols }
     }
 
@@ -500,7 +501,14 @@ impl Problem for CondensedSystem<'_> {
                 for &i in order.iter().take(4) {
                     let n = self.comp.cols[lo + i];
                     let c = mesh.nodes[n as usize];
-                    msg += &format!(" [{:.3e} at ({:.3},{:.3}) P={:.4} H={:.4}]", r[i], c[0], c[2], x[lo + i], h[self.layout.face_index[n as usize] as usize]);
+                    msg += &format!(
+                        " [{:.3e} at ({:.3},{:.3}) P={:.4} H={:.4}]",
+                        r[i],
+                        c[0],
+                        c[2],
+                        x[lo + i],
+                        h[self.layout.face_index[n as usize] as usize]
+                    );
                 }
                 eprintln!("{msg}");
             }
@@ -544,7 +552,12 @@ impl Problem for CondensedSystem<'_> {
         if crate::ehl_options::get().monitor && self.rank == 0 {
             let k = (0..h.len()).min_by(|&a, &b| h[a].partial_cmp(&h[b]).unwrap()).unwrap();
             let at = self.face_xz(k).map(|c| format!(" (X, Z) = ({:.3}, {:.3})", c[0], c[1])).unwrap_or_default();
-            eprintln!("ehl_monitor: limiter {s:.3e}; H0 = {:.4e} dH0 = {dh0:.3e}; min H = {:.3e} at node {}{at}", x[self.layout.h0()], h[k], self.comp.rows[k]);
+            eprintln!(
+                "ehl_monitor: limiter {s:.3e}; H0 = {:.4e} dH0 = {dh0:.3e}; min H = {:.3e} at node {}{at}",
+                x[self.layout.h0()],
+                h[k],
+                self.comp.rows[k]
+            );
         }
         Ok(s)
     }

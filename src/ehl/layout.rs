@@ -91,7 +91,11 @@ impl Layout {
 
     /// Value of an unknown at global index `d` of the iterate `x` (0 for -1: eliminated).
     pub fn value(x: &[f64], d: i32) -> f64 {
-        if d < 0 { 0.0 } else { x[d as usize] }
+        if d < 0 {
+            0.0
+        } else {
+            x[d as usize]
+        }
     }
 
     /// Normal displacement U_y of node `n` in the iterate `x`.

@@ -8,9 +8,9 @@
 use super::layout::Layout;
 use crate::fem::p2tri::{p2_tri_mass, p2_tri_weights, tri_area};
 use crate::mesh::{Mesh, Partition};
+use crate::pcall;
 use crate::petsc::snes::{Eval, Problem};
 use crate::petsc::{ffi, Matrix, Result, Vector};
-use crate::pcall;
 use crate::reynolds::element::{reynolds_element, Fluid, Stabilisation};
 use crate::solid::dofmap::DofMap;
 use mpi::topology::SimpleCommunicator;
@@ -307,7 +307,6 @@ impl EhlProblem for EhlSystem<'_> {
         }
         Ok(())
     }
-
 }
 
 impl Problem for EhlSystem<'_> {
@@ -370,10 +369,18 @@ impl Problem for EhlSystem<'_> {
                 let h = self.element_film(x, e);
                 let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid2, &self.params.stabilisation);
                 let m = out.r.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-                if m > maxr { maxr = m; at = k; }
+                if m > maxr {
+                    maxr = m;
+                    at = k;
+                }
             }
             let e = &self.elements[at];
-            eprintln!("ehl_monitor: max |R_reynolds| = {maxr:.3e} at element {:?} P = {:?} H = {:?}", e.verts, self.element_pressure(x, e), self.element_film(x, e));
+            eprintln!(
+                "ehl_monitor: max |R_reynolds| = {maxr:.3e} at element {:?} P = {:?} H = {:?}",
+                e.verts,
+                self.element_pressure(x, e),
+                self.element_film(x, e)
+            );
             eprintln!("ehl_monitor: max |KU| = {:.3e}, h0 = {}", ku.iter().fold(0.0f64, |a, b| a.max(b.abs())), x[self.layout.h0 as usize]);
         }
         let target = if self.rank == self.layout.ranges.len() - 2 { -self.params.load } else { 0.0 };
@@ -386,18 +393,31 @@ impl Problem for EhlSystem<'_> {
                 for n in 0..self.mesh.nodes.len() {
                     for c in 0..3 {
                         let d = self.layout.u[n][c];
-                        if d >= 0 { nu += all[d as usize].powi(2); }
+                        if d >= 0 {
+                            nu += all[d as usize].powi(2);
+                        }
                     }
                     let d = self.layout.p[n];
                     if d >= 0 {
                         np += all[d as usize].powi(2);
-                        if all[d as usize].abs() > worst { worst = all[d as usize].abs(); worst_at = n; }
+                        if all[d as usize].abs() > worst {
+                            worst = all[d as usize].abs();
+                            worst_at = n;
+                        }
                     }
                 }
                 let c = self.mesh.nodes[worst_at];
-                eprintln!("ehl_monitor: |F_U| = {:.3e} |F_P| = {:.3e} |F_H0| = {:.3e}; worst P row {:.3e} at ({:.3}, {:.3}) P = {:.4} H = {:.4}",
-                    nu.sqrt(), np.sqrt(), all[self.layout.h0 as usize].abs(), worst, c[0], c[2], x[self.layout.p[worst_at] as usize],
-                    self.layout.film(self.mesh, x, worst_at as u32));
+                eprintln!(
+                    "ehl_monitor: |F_U| = {:.3e} |F_P| = {:.3e} |F_H0| = {:.3e}; worst P row {:.3e} at ({:.3}, {:.3}) P = {:.4} H = {:.4}",
+                    nu.sqrt(),
+                    np.sqrt(),
+                    all[self.layout.h0 as usize].abs(),
+                    worst,
+                    c[0],
+                    c[2],
+                    x[self.layout.p[worst_at] as usize],
+                    self.layout.film(self.mesh, x, worst_at as u32)
+                );
             }
         }
         Ok(Eval::Ok)
@@ -446,7 +466,10 @@ impl Problem for EhlSystem<'_> {
             return Ok(0.0);
         }
         if crate::ehl_options::get().monitor && self.rank == 0 {
-            eprintln!("ehl_monitor: step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e} binding at X,Z,H,dH = {at:?}", x[self.layout.h0 as usize]);
+            eprintln!(
+                "ehl_monitor: step limiter {s:.3e}, dH0 = {dh0:.3e}, H0 = {:.3e} binding at X,Z,H,dH = {at:?}",
+                x[self.layout.h0 as usize]
+            );
         }
         Ok(s)
     }
@@ -460,7 +483,14 @@ impl Problem for EhlSystem<'_> {
             pcall!(ffi::MatSetOption(j.raw(), ffi::MatOption_MAT_KEEP_NONZERO_PATTERN, ffi::PetscBool_PETSC_TRUE))?;
         } else {
             // Only the Reynolds rows change: zero them (pattern kept) and refill.
-            pcall!(ffi::MatZeroRows(j.raw(), self.p_rows.len() as i32, self.p_rows.as_ptr(), 0.0, std::ptr::null_mut(), std::ptr::null_mut()))?;
+            pcall!(ffi::MatZeroRows(
+                j.raw(),
+                self.p_rows.len() as i32,
+                self.p_rows.as_ptr(),
+                0.0,
+                std::ptr::null_mut(),
+                std::ptr::null_mut()
+            ))?;
         }
         let fluid = self.fluid();
         for e in &self.elements {
@@ -485,7 +515,11 @@ impl Problem for EhlSystem<'_> {
             // negative by a Newton direction that ignores the penalty.
             let (_, dv) = penalty_law(x[d as usize]);
             if dv != 0.0 || x[d as usize] <= 0.0 {
-                j.add_values(&[d], &[d], &[self.scale_of(d) * self.params.penalty * area * dv.max(if CAVITATION_SMOOTHING > 0.0 { 0.0 } else { 1.0 })])?;
+                j.add_values(
+                    &[d],
+                    &[d],
+                    &[self.scale_of(d) * self.params.penalty * area * dv.max(if CAVITATION_SMOOTHING > 0.0 { 0.0 } else { 1.0 })],
+                )?;
             }
         }
         self.jacobian_built = true;
@@ -501,7 +535,15 @@ mod tests {
     /// strong residual must see the same xi, or SUPG is inconsistent in the cavitated zone.
     #[test]
     fn set_operating_moves_the_penalty_of_rows_and_supg_together() {
-        let mut p = EhlParams { lambda_bar: 1e-3, traction: 1.0, load: 1.0, penalty: 1e4, stabilisation: Stabilisation { penalty: 1e4, ..Default::default() }, velocity: Box::new(|_, _| [1.0, 0.0]), nu: 0.3 };
+        let mut p = EhlParams {
+            lambda_bar: 1e-3,
+            traction: 1.0,
+            load: 1.0,
+            penalty: 1e4,
+            stabilisation: Stabilisation { penalty: 1e4, ..Default::default() },
+            velocity: Box::new(|_, _| [1.0, 0.0]),
+            nu: 0.3,
+        };
         p.set_operating(2e-3, 1e3);
         assert_eq!((p.lambda_bar, p.penalty, p.stabilisation.penalty), (2e-3, 1e3, 1e3));
     }

@@ -33,11 +33,8 @@ impl F1 {
 }
 
 /// u_c(x, y, z) = F[c][0](x) F[c][1](y) F[c][2](z), a different smooth field per component.
-const FIELD: [[F1; 3]; 3] = [
-    [F1::Sin(PI), F1::Sin(PI), F1::Sin(PI)],
-    [F1::Exp(1.0), F1::Sin(PI), F1::Cos(0.5 * PI)],
-    [F1::Cos(PI), F1::Sin(2.0), F1::Exp(0.5)],
-];
+const FIELD: [[F1; 3]; 3] =
+    [[F1::Sin(PI), F1::Sin(PI), F1::Sin(PI)], [F1::Exp(1.0), F1::Sin(PI), F1::Cos(0.5 * PI)], [F1::Cos(PI), F1::Sin(2.0), F1::Exp(0.5)]];
 
 /// Per component, per direction: [value, d1, d2] of each 1D factor.
 fn factors(x: [f64; 3]) -> [[[f64; 3]; 3]; 3] {
@@ -52,13 +49,7 @@ fn exact_u(x: [f64; 3]) -> [f64; 3] {
 /// grad[c][d] = du_c/dx_d.
 fn exact_grad(x: [f64; 3]) -> [[f64; 3]; 3] {
     let f = factors(x);
-    std::array::from_fn(|c| {
-        std::array::from_fn(|d| {
-            (0..3)
-                .map(|e| f[c][e][if e == d { 1 } else { 0 }])
-                .product()
-        })
-    })
+    std::array::from_fn(|c| std::array::from_fn(|d| (0..3).map(|e| f[c][e][if e == d { 1 } else { 0 }]).product()))
 }
 
 /// hess[c][d][e] = d^2 u_c / dx_d dx_e (product rule on the separable factors).
@@ -130,22 +121,14 @@ impl Csr {
         }
     }
     fn diag(&self) -> Vec<f64> {
-        (0..self.n)
-            .map(|i| {
-                (self.ptr[i]..self.ptr[i + 1])
-                    .find(|&k| self.col[k] as usize == i)
-                    .map_or(0.0, |k| self.val[k])
-            })
-            .collect()
+        (0..self.n).map(|i| (self.ptr[i]..self.ptr[i + 1]).find(|&k| self.col[k] as usize == i).map_or(0.0, |k| self.val[k])).collect()
     }
     fn max_asym(&self) -> f64 {
         let mut m: f64 = 0.0;
         for i in 0..self.n {
             for k in self.ptr[i]..self.ptr[i + 1] {
                 let j = self.col[k] as usize;
-                let kt = (self.ptr[j]..self.ptr[j + 1])
-                    .find(|&q| self.col[q] as usize == i)
-                    .unwrap();
+                let kt = (self.ptr[j]..self.ptr[j + 1]).find(|&q| self.col[q] as usize == i).unwrap();
                 m = m.max((self.val[k] - self.val[kt]).abs());
             }
         }
@@ -190,10 +173,7 @@ fn pcg(a: &Csr, b: &[f64], rtol: f64, max_it: usize) -> (Vec<f64>, usize) {
 fn solve(n: usize, lambda: f64, mu: f64) -> (f64, f64, usize) {
     let (nodes, tets) = kuhn_box_mesh([n; 3], [0.0; 3], [1.0; 3]);
     let nn = nodes.len();
-    let on_bnd = |x: &[f64; 3]| {
-        x.iter()
-            .any(|&c| c.abs() < 1e-12 || (c - 1.0).abs() < 1e-12)
-    };
+    let on_bnd = |x: &[f64; 3]| x.iter().any(|&c| c.abs() < 1e-12 || (c - 1.0).abs() < 1e-12);
     // DOF numbering: free DOFs get consecutive ids; Dirichlet DOFs carry the exact value.
     let mut free = vec![u32::MAX; 3 * nn];
     let mut g = vec![0.0; 3 * nn];
@@ -236,10 +216,7 @@ fn solve(n: usize, lambda: f64, mu: f64) -> (f64, f64, usize) {
     }
     let a = Csr::from_triplets(nf, trip);
     let amax = a.val.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    assert!(
-        a.max_asym() <= 1e-14 * amax,
-        "assembled matrix not symmetric"
-    );
+    assert!(a.max_asym() <= 1e-14 * amax, "assembled matrix not symmetric");
     let (x, iters) = pcg(&a, &rhs, 1e-12, 20 * nf + 100);
     let mut u = g;
     for i in 0..3 * nn {
@@ -288,12 +265,7 @@ fn manufactured_body_force_matches_finite_differences() {
             }
         }
         for i in 0..3 {
-            assert!(
-                (f[i] + div[i]).abs() < 1e-6 * (1.0 + f[i].abs()),
-                "f[{i}] = {} vs {}",
-                f[i],
-                -div[i]
-            );
+            assert!((f[i] + div[i]).abs() < 1e-6 * (1.0 + f[i].abs()), "f[{i}] = {} vs {}", f[i], -div[i]);
         }
     }
 }

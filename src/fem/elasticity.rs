@@ -18,10 +18,7 @@ use super::quadrature::TET4_BARY;
 /// `lambda = E nu / ((1 + nu)(1 - 2 nu))`, `mu = E / (2 (1 + nu))`.
 #[inline]
 pub fn lame(e: f64, nu: f64) -> (f64, f64) {
-    (
-        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
-        e / (2.0 * (1.0 + nu)),
-    )
+    (e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), e / (2.0 * (1.0 + nu)))
 }
 
 /// Cauchy stress `sigma = lambda tr(eps) I + 2 mu eps` from a displacement gradient
@@ -55,12 +52,7 @@ pub fn strain_energy_density(grad: &[[f64; 3]; 3], lambda: f64, mu: f64) -> f64 
 
 /// Core kernel; `set(row, col, value)` is called exactly once per entry.
 #[inline(always)]
-fn stiffness_impl(
-    verts: &[[f64; 3]; 4],
-    lambda: f64,
-    mu: f64,
-    mut set: impl FnMut(usize, usize, f64),
-) {
+fn stiffness_impl(verts: &[[f64; 3]; 4], lambda: f64, mu: f64, mut set: impl FnMut(usize, usize, f64)) {
     let geo = AffineTet::new(verts);
     // Each of the 4 points has reference weight 1/24.
     let w = geo.abs_det() / 24.0;
@@ -110,12 +102,7 @@ pub fn elasticity_stiffness(verts: &[[f64; 3]; 4], lambda: f64, mu: f64) -> [[f6
 /// Same as [`elasticity_stiffness`], written row-major into a flat buffer
 /// (`out[30 * r + c]`), the layout expected by `MatSetValues`.
 #[inline]
-pub fn elasticity_stiffness_flat(
-    verts: &[[f64; 3]; 4],
-    lambda: f64,
-    mu: f64,
-    out: &mut [f64; 900],
-) {
+pub fn elasticity_stiffness_flat(verts: &[[f64; 3]; 4], lambda: f64, mu: f64, out: &mut [f64; 900]) {
     stiffness_impl(verts, lambda, mu, |r, c, v| out[30 * r + c] = v);
 }
 
@@ -153,12 +140,7 @@ mod tests {
     use nalgebra::{DMatrix, Matrix3, Vector3};
 
     fn verts() -> [[f64; 3]; 4] {
-        [
-            [0.1, -0.2, 0.3],
-            [1.3, 0.1, 0.2],
-            [0.2, 0.9, -0.1],
-            [0.4, 0.3, 1.1],
-        ]
+        [[0.1, -0.2, 0.3], [1.3, 0.1, 0.2], [0.2, 0.9, -0.1], [0.4, 0.3, 1.1]]
     }
     fn lm() -> (f64, f64) {
         lame(1.0, 0.3)
@@ -204,11 +186,7 @@ mod tests {
             let mut u = [0.0; 30];
             for a in 0..10 {
                 let p = x[a];
-                let r = [
-                    w[1] * p[2] - w[2] * p[1],
-                    w[2] * p[0] - w[0] * p[2],
-                    w[0] * p[1] - w[1] * p[0],
-                ];
+                let r = [w[1] * p[2] - w[2] * p[1], w[2] * p[0] - w[0] * p[2], w[0] * p[1] - w[1] * p[0]];
                 u[3 * a..3 * a + 3].copy_from_slice(&r);
             }
             modes.push(u);
@@ -245,9 +223,7 @@ mod tests {
             }
         }
         let k = elasticity_stiffness(&v, l, m);
-        let uku: f64 = (0..30)
-            .map(|r| u[r] * (0..30).map(|c| k[r][c] * u[c]).sum::<f64>())
-            .sum();
+        let uku: f64 = (0..30).map(|r| u[r] * (0..30).map(|c| k[r][c] * u[c]).sum::<f64>()).sum();
         let sig = stress_from_grad(&a, l, m);
         let mut se = 0.0;
         for i in 0..3 {
@@ -256,11 +232,7 @@ mod tests {
             }
         }
         let vol = AffineTet::new(&v).volume();
-        assert!(
-            (uku - vol * se).abs() < 1e-13 * uku.abs(),
-            "{uku} vs {}",
-            vol * se
-        );
+        assert!((uku - vol * se).abs() < 1e-13 * uku.abs(), "{uku} vs {}", vol * se);
         // Matrix-free action agrees with K u.
         let ku = elasticity_apply(&v, l, m, &u);
         for r in 0..30 {
@@ -280,33 +252,15 @@ mod tests {
         let (l, m) = lm();
         for v in [
             verts(),
-            [
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [0.0, 0.0, 1.0],
-            ],
-            [
-                [0.0, 0.0, 0.0],
-                [3.0, 0.1, 0.0],
-                [0.2, 0.05, 0.02],
-                [0.1, 0.2, 0.4],
-            ],
+            [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            [[0.0, 0.0, 0.0], [3.0, 0.1, 0.0], [0.2, 0.05, 0.02], [0.1, 0.2, 0.4]],
         ] {
             let k = elasticity_stiffness(&v, l, m);
             let mat = DMatrix::from_fn(30, 30, |r, c| k[r][c]);
             let eig = mat.symmetric_eigen();
             let emax = eig.eigenvalues.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-            let zeros = eig
-                .eigenvalues
-                .iter()
-                .filter(|e| e.abs() < 1e-10 * emax)
-                .count();
-            let neg = eig
-                .eigenvalues
-                .iter()
-                .filter(|e| **e < -1e-10 * emax)
-                .count();
+            let zeros = eig.eigenvalues.iter().filter(|e| e.abs() < 1e-10 * emax).count();
+            let neg = eig.eigenvalues.iter().filter(|e| **e < -1e-10 * emax).count();
             assert_eq!(zeros, 6, "eigenvalues {:?}", eig.eigenvalues);
             assert_eq!(neg, 0);
         }
@@ -343,9 +297,7 @@ mod tests {
             let h = 1e-4;
             let mut e = 0.0;
             for (p, w) in rule.iter() {
-                let x: [f64; 3] = std::array::from_fn(|i| {
-                    v[0][i] + (0..3).map(|j| jm[(i, j)] * p[j]).sum::<f64>()
-                });
+                let x: [f64; 3] = std::array::from_fn(|i| v[0][i] + (0..3).map(|j| jm[(i, j)] * p[j]).sum::<f64>());
                 let mut g = [[0.0; 3]; 3];
                 for d in 0..3 {
                     let (mut xp, mut xm) = (x, x);
@@ -366,28 +318,11 @@ mod tests {
             u
         };
         let s = maxabs(&k);
-        for (r, c) in [
-            (0, 0),
-            (0, 1),
-            (3, 14),
-            (12, 12),
-            (13, 29),
-            (29, 29),
-            (5, 22),
-            (17, 8),
-        ] {
+        for (r, c) in [(0, 0), (0, 1), (3, 14), (12, 12), (13, 29), (29, 29), (5, 22), (17, 8)] {
             let mut uc = unit(r);
             uc[c] += 1.0;
-            let kn = if r == c {
-                2.0 * energy(&unit(r))
-            } else {
-                energy(&uc) - energy(&unit(r)) - energy(&unit(c))
-            };
-            assert!(
-                (kn - k[r][c]).abs() < 1e-7 * s,
-                "K[{r}][{c}] = {} vs numerical {kn}",
-                k[r][c]
-            );
+            let kn = if r == c { 2.0 * energy(&unit(r)) } else { energy(&uc) - energy(&unit(r)) - energy(&unit(c)) };
+            assert!((kn - k[r][c]).abs() < 1e-7 * s, "K[{r}][{c}] = {} vs numerical {kn}", k[r][c]);
         }
     }
 
@@ -396,11 +331,7 @@ mod tests {
         // Not a strict benchmark; prints the per-element cost in release builds.
         let (l, m) = lm();
         let mut v = verts();
-        let n = if cfg!(debug_assertions) {
-            2_000
-        } else {
-            200_000
-        };
+        let n = if cfg!(debug_assertions) { 2_000 } else { 200_000 };
         let mut acc = 0.0;
         let mut out = [0.0; 900];
         let t = std::time::Instant::now();
@@ -410,9 +341,6 @@ mod tests {
             acc += out[37];
         }
         let dt = t.elapsed().as_secs_f64();
-        eprintln!(
-            "elasticity_stiffness_flat: {:.3} us/element (acc {acc:.3})",
-            1e6 * dt / n as f64
-        );
+        eprintln!("elasticity_stiffness_flat: {:.3} us/element (acc {acc:.3})", 1e6 * dt / n as f64);
     }
 }

@@ -18,11 +18,7 @@ fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 #[inline(always)]
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 #[inline(always)]
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -66,24 +62,14 @@ impl AffineTet {
         let g1 = [c1[0] * inv, c1[1] * inv, c1[2] * inv];
         let g2 = [c2[0] * inv, c2[1] * inv, c2[2] * inv];
         let g3 = [c3[0] * inv, c3[1] * inv, c3[2] * inv];
-        let g0 = [
-            -(g1[0] + g2[0] + g3[0]),
-            -(g1[1] + g2[1] + g3[1]),
-            -(g1[2] + g2[2] + g3[2]),
-        ];
+        let g0 = [-(g1[0] + g2[0] + g3[0]), -(g1[1] + g2[1] + g3[1]), -(g1[2] + g2[2] + g3[2])];
         let mut jac = [[0.0; 3]; 3];
         let mut jinv_t = [[0.0; 3]; 3];
         for i in 0..3 {
             jac[i] = [e1[i], e2[i], e3[i]];
             jinv_t[i] = [g1[i], g2[i], g3[i]];
         }
-        AffineTet {
-            x0: v[0],
-            jac,
-            det,
-            jinv_t,
-            grad_bary: [g0, g1, g2, g3],
-        }
+        AffineTet { x0: v[0], jac, det, jinv_t, grad_bary: [g0, g1, g2, g3] }
     }
 
     /// Element volume `|det J| / 6`.
@@ -192,12 +178,7 @@ impl AffineTri {
         let g1 = [e2[1] * inv, -e2[0] * inv];
         let g2 = [-e1[1] * inv, e1[0] * inv];
         let g0 = [-(g1[0] + g2[0]), -(g1[1] + g2[1])];
-        AffineTri {
-            x0: v[0],
-            jac: [[e1[0], e2[0]], [e1[1], e2[1]]],
-            det,
-            grad_bary: [g0, g1, g2],
-        }
+        AffineTri { x0: v[0], jac: [[e1[0], e2[0]], [e1[1], e2[1]]], det, grad_bary: [g0, g1, g2] }
     }
     /// Area `|det J| / 2`.
     #[inline]
@@ -212,10 +193,7 @@ impl AffineTri {
     /// Physical point of a reference point.
     #[inline]
     pub fn map(&self, xi: [f64; 2]) -> [f64; 2] {
-        [
-            self.x0[0] + self.jac[0][0] * xi[0] + self.jac[0][1] * xi[1],
-            self.x0[1] + self.jac[1][0] * xi[0] + self.jac[1][1] * xi[1],
-        ]
+        [self.x0[0] + self.jac[0][0] * xi[0] + self.jac[0][1] * xi[1], self.x0[1] + self.jac[1][0] * xi[0] + self.jac[1][1] * xi[1]]
     }
     /// Physical gradients of the 6 P2 shape functions at a reference point.
     #[inline]
@@ -230,12 +208,7 @@ mod tests {
     use crate::fem::p2tet::p2_tet_ref_grads;
 
     fn verts() -> [[f64; 3]; 4] {
-        [
-            [0.1, -0.2, 0.3],
-            [1.3, 0.1, 0.2],
-            [0.2, 0.9, -0.1],
-            [0.4, 0.3, 1.1],
-        ]
+        [[0.1, -0.2, 0.3], [1.3, 0.1, 0.2], [0.2, 0.9, -0.1], [0.4, 0.3, 1.1]]
     }
 
     #[test]
@@ -300,9 +273,7 @@ mod tests {
     fn triangle_map() {
         let v = [[0.1, 0.2], [1.1, 0.4], [0.3, 1.5]];
         let t = AffineTri::new(&v);
-        let area = 0.5
-            * ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1])
-                - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1]));
+        let area = 0.5 * ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1]));
         assert!((t.area() - area.abs()).abs() < 1e-15);
         for k in 0..3 {
             for m in 1..3 {

@@ -8,11 +8,7 @@ use super::quadrature::{TetRule, TriRule};
 /// (node-major, 30 entries), integrated with `rule` on the reference tetrahedron.
 /// Choose the rule degree as 2 + the degree of `f` (exact) or higher for smooth
 /// non-polynomial `f`.
-pub fn body_force_load(
-    verts: &[[f64; 3]; 4],
-    f: impl Fn([f64; 3]) -> [f64; 3],
-    rule: &TetRule,
-) -> [f64; 30] {
+pub fn body_force_load(verts: &[[f64; 3]; 4], f: impl Fn([f64; 3]) -> [f64; 3], rule: &TetRule) -> [f64; 30] {
     let geo = AffineTet::new(verts);
     let det = geo.abs_det();
     let mut out = [0.0; 30];
@@ -37,11 +33,7 @@ pub fn body_force_load(
 /// component with the sign of the surface normal.
 ///
 /// For constant `p` the vertex entries vanish and each midside entry is `p |S| / 3`.
-pub fn tri_normal_load(
-    verts2d: &[[f64; 2]; 3],
-    p: impl Fn(f64, f64) -> f64,
-    rule: &TriRule,
-) -> [f64; 6] {
+pub fn tri_normal_load(verts2d: &[[f64; 2]; 3], p: impl Fn(f64, f64) -> f64, rule: &TriRule) -> [f64; 6] {
     let geo = AffineTri::new(verts2d);
     let det = geo.abs_det();
     let mut out = [0.0; 6];
@@ -99,12 +91,7 @@ mod tests {
 
     #[test]
     fn body_force_consistency() {
-        let v = [
-            [0.1, -0.2, 0.3],
-            [1.3, 0.1, 0.2],
-            [0.2, 0.9, -0.1],
-            [0.4, 0.3, 1.1],
-        ];
+        let v = [[0.1, -0.2, 0.3], [1.3, 0.1, 0.2], [0.2, 0.9, -0.1], [0.4, 0.3, 1.1]];
         let geo = AffineTet::new(&v);
         let f = body_force_load(&v, |_| [1.0, -2.0, 0.5], tet_rule(2));
         // Constant force: vertex entries -vol/20, midside +vol/5 (P2 property).

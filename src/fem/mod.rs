@@ -32,9 +32,7 @@ pub mod testmesh;
 #[cfg(test)]
 mod convergence_tests;
 
-pub use elasticity::{
-    elasticity_apply, elasticity_stiffness, elasticity_stiffness_flat, lame, stress_from_grad,
-};
+pub use elasticity::{elasticity_apply, elasticity_stiffness, elasticity_stiffness_flat, lame, stress_from_grad};
 pub use geometry::{tet_signed_volume, AffineTet, AffineTri};
 pub use loads::{body_force_load, tri_normal_load};
 pub use norms::{h1_seminorm_error_sq, l2_error_sq};

@@ -6,12 +6,7 @@ use super::quadrature::TetRule;
 /// Squared L2 error `int_T |u_h - u|^2 dx` of a P2 vector field (30 node-major DOFs)
 /// against an exact field, integrated with `rule`. Sum over elements and take the square
 /// root for the global norm.
-pub fn l2_error_sq(
-    verts: &[[f64; 3]; 4],
-    u_local: &[f64; 30],
-    exact: impl Fn([f64; 3]) -> [f64; 3],
-    rule: &TetRule,
-) -> f64 {
+pub fn l2_error_sq(verts: &[[f64; 3]; 4], u_local: &[f64; 30], exact: impl Fn([f64; 3]) -> [f64; 3], rule: &TetRule) -> f64 {
     let geo = AffineTet::new(verts);
     let mut s = 0.0;
     for (p, w) in rule.iter() {
@@ -61,12 +56,7 @@ mod tests {
 
     #[test]
     fn quadratic_field_has_zero_error_and_known_norms() {
-        let v = [
-            [0.1, -0.2, 0.3],
-            [1.3, 0.1, 0.2],
-            [0.2, 0.9, -0.1],
-            [0.4, 0.3, 1.1],
-        ];
+        let v = [[0.1, -0.2, 0.3], [1.3, 0.1, 0.2], [0.2, 0.9, -0.1], [0.4, 0.3, 1.1]];
         let x = p2_tet_node_coords(&v);
         let f = |p: [f64; 3]| [p[0] * p[1], 1.0 - p[2] * p[2], p[0] + 2.0 * p[1]];
         let g = |p: [f64; 3]| [[p[1], p[0], 0.0], [0.0, 0.0, -2.0 * p[2]], [1.0, 2.0, 0.0]];

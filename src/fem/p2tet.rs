@@ -24,12 +24,7 @@ pub const P2_TET_REF_NODES: [[f64; 3]; 10] = [
 ];
 
 /// Gradients of the barycentric coordinates with respect to the reference coordinates.
-pub const TET_REF_GRAD_BARY: [[f64; 3]; 4] = [
-    [-1.0, -1.0, -1.0],
-    [1.0, 0.0, 0.0],
-    [0.0, 1.0, 0.0],
-    [0.0, 0.0, 1.0],
-];
+pub const TET_REF_GRAD_BARY: [[f64; 3]; 4] = [[-1.0, -1.0, -1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 /// Barycentric coordinates `(1 - x - y - z, x, y, z)` of a reference point.
 #[inline(always)]
@@ -127,13 +122,7 @@ mod tests {
     use super::*;
 
     fn pts() -> Vec<[f64; 3]> {
-        vec![
-            [0.1, 0.2, 0.3],
-            [0.25, 0.25, 0.25],
-            [0.7, 0.1, 0.05],
-            [0.0, 0.3, 0.6],
-            [0.33, 0.01, 0.5],
-        ]
+        vec![[0.1, 0.2, 0.3], [0.25, 0.25, 0.25], [0.7, 0.1, 0.05], [0.0, 0.3, 0.6], [0.33, 0.01, 0.5]]
     }
 
     #[test]
@@ -169,14 +158,8 @@ mod tests {
     /// A general quadratic and its gradient.
     fn quad(x: [f64; 3]) -> (f64, [f64; 3]) {
         let [a, b, c] = x;
-        let v = 1.0 + 2.0 * a - b + 0.5 * c + 3.0 * a * a - a * b + 2.0 * b * c + 0.7 * c * c
-            - 1.3 * a * c
-            + 0.4 * b * b;
-        let g = [
-            2.0 + 6.0 * a - b - 1.3 * c,
-            -1.0 - a + 2.0 * c + 0.8 * b,
-            0.5 + 2.0 * b + 1.4 * c - 1.3 * a,
-        ];
+        let v = 1.0 + 2.0 * a - b + 0.5 * c + 3.0 * a * a - a * b + 2.0 * b * c + 0.7 * c * c - 1.3 * a * c + 0.4 * b * b;
+        let g = [2.0 + 6.0 * a - b - 1.3 * c, -1.0 - a + 2.0 * c + 0.8 * b, 0.5 + 2.0 * b + 1.4 * c - 1.3 * a];
         (v, g)
     }
 

@@ -8,14 +8,7 @@
 pub const TRI_EDGES: [[usize; 2]; 3] = [[0, 1], [1, 2], [2, 0]];
 
 /// Reference coordinates of the 6 nodes.
-pub const P2_TRI_REF_NODES: [[f64; 2]; 6] = [
-    [0.0, 0.0],
-    [1.0, 0.0],
-    [0.0, 1.0],
-    [0.5, 0.0],
-    [0.5, 0.5],
-    [0.0, 0.5],
-];
+pub const P2_TRI_REF_NODES: [[f64; 2]; 6] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5]];
 
 /// Gradients of the barycentric coordinates with respect to the reference coordinates.
 pub const TRI_REF_GRAD_BARY: [[f64; 2]; 3] = [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]];
@@ -158,12 +151,7 @@ impl P2Triangle {
         for (m, [a, b]) in TRI_EDGES.iter().enumerate() {
             lap[3 + m] = 8.0 * dot2(grad_l[*a], grad_l[*b]);
         }
-        Self {
-            verts: *verts,
-            area: 0.5 * det.abs(),
-            grad_l,
-            lap,
-        }
+        Self { verts: *verts, area: 0.5 * det.abs(), grad_l, lap }
     }
 
     /// Shape function values at barycentric point `l`.
@@ -179,10 +167,7 @@ impl P2Triangle {
     /// Physical point of barycentric point `l`.
     pub fn point(&self, l: &[f64; 3]) -> [f64; 2] {
         let v = &self.verts;
-        [
-            l[0] * v[0][0] + l[1] * v[1][0] + l[2] * v[2][0],
-            l[0] * v[0][1] + l[1] * v[1][1] + l[2] * v[2][1],
-        ]
+        [l[0] * v[0][0] + l[1] * v[1][0] + l[2] * v[2][0], l[0] * v[0][1] + l[1] * v[1][1] + l[2] * v[2][1]]
     }
 
     /// Coordinates of the six nodes.
@@ -202,21 +187,12 @@ mod tests {
     use super::*;
 
     fn pts() -> Vec<[f64; 2]> {
-        vec![
-            [0.1, 0.2],
-            [1.0 / 3.0, 1.0 / 3.0],
-            [0.7, 0.1],
-            [0.0, 0.6],
-            [0.45, 0.5],
-        ]
+        vec![[0.1, 0.2], [1.0 / 3.0, 1.0 / 3.0], [0.7, 0.1], [0.0, 0.6], [0.45, 0.5]]
     }
 
     fn quad(x: [f64; 2]) -> (f64, [f64; 2]) {
         let [s, t] = x;
-        (
-            0.3 - s + 2.0 * t + 1.5 * s * s - 0.7 * s * t + 2.2 * t * t,
-            [-1.0 + 3.0 * s - 0.7 * t, 2.0 - 0.7 * s + 4.4 * t],
-        )
+        (0.3 - s + 2.0 * t + 1.5 * s * s - 0.7 * s * t + 2.2 * t * t, [-1.0 + 3.0 * s - 0.7 * t, 2.0 - 0.7 * s + 4.4 * t])
     }
 
     #[test]
@@ -237,10 +213,7 @@ mod tests {
         }
         for (e, [i, j]) in TRI_EDGES.iter().enumerate() {
             for c in 0..2 {
-                assert_eq!(
-                    0.5 * (P2_TRI_REF_NODES[*i][c] + P2_TRI_REF_NODES[*j][c]),
-                    P2_TRI_REF_NODES[3 + e][c]
-                );
+                assert_eq!(0.5 * (P2_TRI_REF_NODES[*i][c] + P2_TRI_REF_NODES[*j][c]), P2_TRI_REF_NODES[3 + e][c]);
             }
         }
     }
@@ -308,14 +281,7 @@ mod tests {
             assert!((gx - gq(x)[0]).abs() < 1e-12 && (gz - gq(x)[1]).abs() < 1e-12);
         }
         // partition of unity, Kronecker property at nodes
-        let bary = [
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.5, 0.5, 0.0],
-            [0.0, 0.5, 0.5],
-            [0.5, 0.0, 0.5],
-        ];
+        let bary = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]];
         for (j, l) in bary.iter().enumerate() {
             let n = P2Triangle::shape(l);
             for i in 0..6 {
@@ -325,10 +291,7 @@ mod tests {
         // load weights integrate the quadratic exactly (compare with quadrature)
         let w = e.load_weights();
         let int_w: f64 = (0..6).map(|i| w[i] * nodal[i]).sum();
-        let int_q: f64 = crate::fem::quadrature::DUNAVANT6
-            .iter()
-            .map(|p| p.w * e.area * q(e.point(&p.l)))
-            .sum();
+        let int_q: f64 = crate::fem::quadrature::DUNAVANT6.iter().map(|p| p.w * e.area * q(e.point(&p.l))).sum();
         assert!((int_w - int_q).abs() < 1e-13);
     }
 

@@ -61,10 +61,7 @@ impl<const D: usize> QuadRule<D> {
     }
     /// Iterate over `(point, weight)` pairs.
     pub fn iter(&self) -> impl Iterator<Item = ([f64; D], f64)> + '_ {
-        self.points
-            .iter()
-            .copied()
-            .zip(self.weights.iter().copied())
+        self.points.iter().copied().zip(self.weights.iter().copied())
     }
     /// Sum of the weights (the reference measure).
     pub fn weight_sum(&self) -> f64 {
@@ -136,25 +133,13 @@ fn expand_tri(name: &'static str, degree: u32, orbits: &[TriOrbit]) -> TriRule {
             }
             TriOrbit::S111(a, b, w) => {
                 let c = 1.0 - a - b;
-                for l in [
-                    [a, b, c],
-                    [a, c, b],
-                    [b, a, c],
-                    [b, c, a],
-                    [c, a, b],
-                    [c, b, a],
-                ] {
+                for l in [[a, b, c], [a, c, b], [b, a, c], [b, c, a], [c, a, b], [c, b, a]] {
                     bary.push((l, w));
                 }
             }
         }
     }
-    TriRule {
-        name,
-        degree,
-        points: bary.iter().map(|(l, _)| [l[1], l[2]]).collect(),
-        weights: bary.iter().map(|(_, w)| *w).collect(),
-    }
+    TriRule { name, degree, points: bary.iter().map(|(l, _)| [l[1], l[2]]).collect(), weights: bary.iter().map(|(_, w)| *w).collect() }
 }
 
 /// Barycentric points of the classical 4-point degree-2 tetrahedron rule (weights 1/24):
@@ -165,30 +150,18 @@ pub const TET4_BARY: [[f64; 4]; 4] = {
     [[A, B, B, B], [B, A, B, B], [B, B, A, B], [B, B, B, A]]
 };
 
-static TET_D1: LazyLock<TetRule> =
-    LazyLock::new(|| expand_tet("tet centroid (1 pt, deg 1)", 1, &[TetOrbit::S4(1.0 / 6.0)]));
+static TET_D1: LazyLock<TetRule> = LazyLock::new(|| expand_tet("tet centroid (1 pt, deg 1)", 1, &[TetOrbit::S4(1.0 / 6.0)]));
 
-static TET_D2: LazyLock<TetRule> = LazyLock::new(|| {
-    expand_tet(
-        "tet S31 (4 pt, deg 2)",
-        2,
-        &[TetOrbit::S31(0.138_196_601_125_010_515_179_5, 1.0 / 24.0)],
-    )
-});
+static TET_D2: LazyLock<TetRule> =
+    LazyLock::new(|| expand_tet("tet S31 (4 pt, deg 2)", 2, &[TetOrbit::S31(0.138_196_601_125_010_515_179_5, 1.0 / 24.0)]));
 
 static TET_D3: LazyLock<TetRule> = LazyLock::new(|| {
     expand_tet(
         "tet 2xS31 positive (8 pt, deg 3)",
         3,
         &[
-            TetOrbit::S31(
-                0.328_054_696_711_426_647_335_8,
-                0.023_087_994_418_643_690_387_27,
-            ),
-            TetOrbit::S31(
-                0.106_952_273_932_930_682_771_7,
-                0.018_578_672_248_022_976_279_4,
-            ),
+            TetOrbit::S31(0.328_054_696_711_426_647_335_8, 0.023_087_994_418_643_690_387_27),
+            TetOrbit::S31(0.106_952_273_932_930_682_771_7, 0.018_578_672_248_022_976_279_4),
         ],
     )
 });
@@ -198,46 +171,24 @@ static TET_D5: LazyLock<TetRule> = LazyLock::new(|| {
         "tet Walkington 14 pt (deg 5)",
         5,
         &[
-            TetOrbit::S31(
-                0.310_885_919_263_300_609_797_3,
-                0.018_781_320_953_002_641_799_86,
-            ),
-            TetOrbit::S31(
-                0.092_735_250_310_891_226_402_32,
-                0.012_248_840_519_393_658_257_29,
-            ),
-            TetOrbit::S22(
-                0.045_503_704_125_649_649_491_88,
-                0.007_091_003_462_846_911_073_012,
-            ),
+            TetOrbit::S31(0.310_885_919_263_300_609_797_3, 0.018_781_320_953_002_641_799_86),
+            TetOrbit::S31(0.092_735_250_310_891_226_402_32, 0.012_248_840_519_393_658_257_29),
+            TetOrbit::S22(0.045_503_704_125_649_649_491_88, 0.007_091_003_462_846_911_073_012),
         ],
     )
 });
 
-static TRI_D1: LazyLock<TriRule> =
-    LazyLock::new(|| expand_tri("tri centroid (1 pt, deg 1)", 1, &[TriOrbit::S3(0.5)]));
+static TRI_D1: LazyLock<TriRule> = LazyLock::new(|| expand_tri("tri centroid (1 pt, deg 1)", 1, &[TriOrbit::S3(0.5)]));
 
-static TRI_D2: LazyLock<TriRule> = LazyLock::new(|| {
-    expand_tri(
-        "tri 3 pt (deg 2)",
-        2,
-        &[TriOrbit::S21(1.0 / 6.0, 1.0 / 6.0)],
-    )
-});
+static TRI_D2: LazyLock<TriRule> = LazyLock::new(|| expand_tri("tri 3 pt (deg 2)", 2, &[TriOrbit::S21(1.0 / 6.0, 1.0 / 6.0)]));
 
 static TRI_D4: LazyLock<TriRule> = LazyLock::new(|| {
     expand_tri(
         "tri Dunavant 6 pt (deg 4)",
         4,
         &[
-            TriOrbit::S21(
-                0.445_948_490_915_964_886_318_3,
-                0.111_690_794_839_005_732_847_5,
-            ),
-            TriOrbit::S21(
-                0.091_576_213_509_770_743_459_57,
-                0.054_975_871_827_660_933_819_16,
-            ),
+            TriOrbit::S21(0.445_948_490_915_964_886_318_3, 0.111_690_794_839_005_732_847_5),
+            TriOrbit::S21(0.091_576_213_509_770_743_459_57, 0.054_975_871_827_660_933_819_16),
         ],
     )
 });
@@ -248,14 +199,8 @@ static TRI_D5: LazyLock<TriRule> = LazyLock::new(|| {
         5,
         &[
             TriOrbit::S3(9.0 / 80.0),
-            TriOrbit::S21(
-                0.101_286_507_323_456_338_801,
-                0.062_969_590_272_413_576_297_84,
-            ),
-            TriOrbit::S21(
-                0.470_142_064_105_115_089_770_4,
-                0.066_197_076_394_253_090_368_82,
-            ),
+            TriOrbit::S21(0.101_286_507_323_456_338_801, 0.062_969_590_272_413_576_297_84),
+            TriOrbit::S21(0.470_142_064_105_115_089_770_4, 0.066_197_076_394_253_090_368_82),
         ],
     )
 });
@@ -266,23 +211,10 @@ static TRI_D8: LazyLock<TriRule> = LazyLock::new(|| {
         8,
         &[
             TriOrbit::S3(0.072_157_803_838_893_584_125_55),
-            TriOrbit::S21(
-                0.459_292_588_292_723_156_028_8,
-                0.047_545_817_133_642_312_396_95,
-            ),
-            TriOrbit::S21(
-                0.170_569_307_751_760_206_622_3,
-                0.051_608_685_267_359_125_140_9,
-            ),
-            TriOrbit::S21(
-                0.050_547_228_317_030_975_458_42,
-                0.016_229_248_811_599_040_155_46,
-            ),
-            TriOrbit::S111(
-                0.263_112_829_634_638_113_421_8,
-                0.008_394_777_409_957_605_337_214,
-                0.013_615_157_087_217_497_132_42,
-            ),
+            TriOrbit::S21(0.459_292_588_292_723_156_028_8, 0.047_545_817_133_642_312_396_95),
+            TriOrbit::S21(0.170_569_307_751_760_206_622_3, 0.051_608_685_267_359_125_140_9),
+            TriOrbit::S21(0.050_547_228_317_030_975_458_42, 0.016_229_248_811_599_040_155_46),
+            TriOrbit::S111(0.263_112_829_634_638_113_421_8, 0.008_394_777_409_957_605_337_214, 0.013_615_157_087_217_497_132_42),
         ],
     )
 });
@@ -344,10 +276,8 @@ static TRI_D6: LazyLock<TriRule> = LazyLock::new(|| TriRule {
 });
 
 const MAX_COLLAPSED: usize = 40;
-static TET_COLLAPSED: [OnceLock<TetRule>; MAX_COLLAPSED + 1] =
-    [const { OnceLock::new() }; MAX_COLLAPSED + 1];
-static TRI_COLLAPSED: [OnceLock<TriRule>; MAX_COLLAPSED + 1] =
-    [const { OnceLock::new() }; MAX_COLLAPSED + 1];
+static TET_COLLAPSED: [OnceLock<TetRule>; MAX_COLLAPSED + 1] = [const { OnceLock::new() }; MAX_COLLAPSED + 1];
+static TRI_COLLAPSED: [OnceLock<TriRule>; MAX_COLLAPSED + 1] = [const { OnceLock::new() }; MAX_COLLAPSED + 1];
 
 /// The cheapest built-in tetrahedron rule exact for polynomials of total degree `degree`.
 ///
@@ -360,9 +290,7 @@ pub fn tet_rule(degree: u32) -> &'static TetRule {
         2 => &TET_D2,
         3 => &TET_D3,
         4 | 5 => &TET_D5,
-        d if (d as usize) <= MAX_COLLAPSED => {
-            TET_COLLAPSED[d as usize].get_or_init(|| tet_collapsed_gauss(d))
-        }
+        d if (d as usize) <= MAX_COLLAPSED => TET_COLLAPSED[d as usize].get_or_init(|| tet_collapsed_gauss(d)),
         d => panic!("tet_rule: degree {d} > {MAX_COLLAPSED} not supported"),
     }
 }
@@ -380,9 +308,7 @@ pub fn tri_rule(degree: u32) -> &'static TriRule {
         5 => &TRI_D5,
         6 => &TRI_D6,
         7 | 8 => &TRI_D8,
-        d if (d as usize) <= MAX_COLLAPSED => {
-            TRI_COLLAPSED[d as usize].get_or_init(|| tri_collapsed_gauss(d))
-        }
+        d if (d as usize) <= MAX_COLLAPSED => TRI_COLLAPSED[d as usize].get_or_init(|| tri_collapsed_gauss(d)),
         d => panic!("tri_rule: degree {d} > {MAX_COLLAPSED} not supported"),
     }
 }
@@ -445,12 +371,7 @@ pub fn tet_collapsed_gauss(degree: u32) -> TetRule {
             }
         }
     }
-    TetRule {
-        name: "tet collapsed Gauss-Legendre",
-        degree,
-        points,
-        weights,
-    }
+    TetRule { name: "tet collapsed Gauss-Legendre", degree, points, weights }
 }
 
 /// Collapsed (Duffy) Gauss-Legendre rule on the reference triangle, exact for total
@@ -469,12 +390,7 @@ pub fn tri_collapsed_gauss(degree: u32) -> TriRule {
             weights.push(wu[i] * wv[j] * (1.0 - u));
         }
     }
-    TriRule {
-        name: "tri collapsed Gauss-Legendre",
-        degree,
-        points,
-        weights,
-    }
+    TriRule { name: "tri collapsed Gauss-Legendre", degree, points, weights }
 }
 
 #[cfg(test)]
@@ -495,36 +411,19 @@ mod tests {
     }
 
     fn check_tet(rule: &TetRule) {
-        assert!(
-            (rule.weight_sum() - 1.0 / 6.0).abs() < 1e-15,
-            "{}",
-            rule.name
-        );
+        assert!((rule.weight_sum() - 1.0 / 6.0).abs() < 1e-15, "{}", rule.name);
         assert!(rule.weights.iter().all(|&w| w > 0.0), "{}", rule.name);
         for p in &rule.points {
             let l0 = 1.0 - p[0] - p[1] - p[2];
-            assert!(
-                p.iter().all(|&x| x > 0.0) && l0 > 0.0,
-                "{}: exterior point",
-                rule.name
-            );
+            assert!(p.iter().all(|&x| x > 0.0) && l0 > 0.0, "{}: exterior point", rule.name);
         }
         let d = rule.degree;
         for a in 0..=d {
             for b in 0..=d - a {
                 for c in 0..=d - a - b {
-                    let q: f64 = rule
-                        .iter()
-                        .map(|(p, w)| {
-                            w * p[0].powi(a as i32) * p[1].powi(b as i32) * p[2].powi(c as i32)
-                        })
-                        .sum();
+                    let q: f64 = rule.iter().map(|(p, w)| w * p[0].powi(a as i32) * p[1].powi(b as i32) * p[2].powi(c as i32)).sum();
                     let ex = tet_monomial(a, b, c);
-                    assert!(
-                        (q - ex).abs() <= 1e-14 * ex.max(1e-3),
-                        "{}: x^{a} y^{b} z^{c}: {q} vs {ex}",
-                        rule.name
-                    );
+                    assert!((q - ex).abs() <= 1e-14 * ex.max(1e-3), "{}: x^{a} y^{b} z^{c}: {q} vs {ex}", rule.name);
                 }
             }
         }
@@ -534,25 +433,14 @@ mod tests {
         assert!((rule.weight_sum() - 0.5).abs() < 1e-15, "{}", rule.name);
         assert!(rule.weights.iter().all(|&w| w > 0.0), "{}", rule.name);
         for p in &rule.points {
-            assert!(
-                p[0] > 0.0 && p[1] > 0.0 && 1.0 - p[0] - p[1] > 0.0,
-                "{}",
-                rule.name
-            );
+            assert!(p[0] > 0.0 && p[1] > 0.0 && 1.0 - p[0] - p[1] > 0.0, "{}", rule.name);
         }
         let d = rule.degree;
         for a in 0..=d {
             for b in 0..=d - a {
-                let q: f64 = rule
-                    .iter()
-                    .map(|(p, w)| w * p[0].powi(a as i32) * p[1].powi(b as i32))
-                    .sum();
+                let q: f64 = rule.iter().map(|(p, w)| w * p[0].powi(a as i32) * p[1].powi(b as i32)).sum();
                 let ex = tri_monomial(a, b);
-                assert!(
-                    (q - ex).abs() <= 1e-14 * ex.max(1e-3),
-                    "{}: x^{a} y^{b}: {q} vs {ex}",
-                    rule.name
-                );
+                assert!((q - ex).abs() <= 1e-14 * ex.max(1e-3), "{}: x^{a} y^{b}: {q} vs {ex}", rule.name);
             }
         }
     }
@@ -584,12 +472,7 @@ mod tests {
             for a in 0..=d {
                 for b in 0..=d - a {
                     let c = d - a - b;
-                    let q: f64 = r
-                        .iter()
-                        .map(|(p, w)| {
-                            w * p[0].powi(a as i32) * p[1].powi(b as i32) * p[2].powi(c as i32)
-                        })
-                        .sum();
+                    let q: f64 = r.iter().map(|(p, w)| w * p[0].powi(a as i32) * p[1].powi(b as i32) * p[2].powi(c as i32)).sum();
                     let ex = tet_monomial(a, b, c);
                     worst = worst.max((q - ex).abs() / ex);
                 }
@@ -630,11 +513,7 @@ mod tests {
         let r = tet_rule(2);
         for (i, l) in TET4_BARY.iter().enumerate() {
             let p = r.points[i];
-            assert!(
-                (p[0] - l[1]).abs() < 1e-15
-                    && (p[1] - l[2]).abs() < 1e-15
-                    && (p[2] - l[3]).abs() < 1e-15
-            );
+            assert!((p[0] - l[1]).abs() < 1e-15 && (p[1] - l[2]).abs() < 1e-15 && (p[2] - l[3]).abs() < 1e-15);
             assert!((l.iter().sum::<f64>() - 1.0).abs() < 1e-15);
         }
     }
@@ -652,14 +531,8 @@ mod tests {
         for a in 0..=6u32 {
             for b in 0..=(6 - a) {
                 for c in 0..=(6 - a - b) {
-                    let q: f64 = DUNAVANT6
-                        .iter()
-                        .map(|p| {
-                            p.w * p.l[0].powi(a as i32)
-                                * p.l[1].powi(b as i32)
-                                * p.l[2].powi(c as i32)
-                        })
-                        .sum();
+                    let q: f64 =
+                        DUNAVANT6.iter().map(|p| p.w * p.l[0].powi(a as i32) * p.l[1].powi(b as i32) * p.l[2].powi(c as i32)).sum();
                     let e = exact_bary(a, b, c);
                     assert!((q - e).abs() < 1e-14, "L0^{a} L1^{b} L2^{c}: {q} vs {e}");
                 }

@@ -15,17 +15,11 @@ use super::p2tet::TET_EDGES;
 ///
 /// Midside-node coordinates are exactly the edge midpoints (the mesh is straight-sided).
 pub fn kuhn_box_mesh(n: [usize; 3], lo: [f64; 3], hi: [f64; 3]) -> (Vec<[f64; 3]>, Vec<[u32; 10]>) {
-    assert!(
-        n.iter().all(|&m| m >= 1),
-        "kuhn_box_mesh: need at least one cell per direction"
-    );
+    assert!(n.iter().all(|&m| m >= 1), "kuhn_box_mesh: need at least one cell per direction");
     let nv = [n[0] + 1, n[1] + 1, n[2] + 1];
     let nf = [2 * n[0] + 1, 2 * n[1] + 1, 2 * n[2] + 1];
     let total_fine = nf[0] * nf[1] * nf[2];
-    assert!(
-        total_fine < u32::MAX as usize,
-        "kuhn_box_mesh: too many nodes for u32"
-    );
+    assert!(total_fine < u32::MAX as usize, "kuhn_box_mesh: too many nodes for u32");
     // Coordinate of fine-grid index f in direction d (fine grid = half spacing).
     let coord = |d: usize, f: usize| -> f64 {
         if f == 2 * n[d] {
@@ -48,14 +42,8 @@ pub fn kuhn_box_mesh(n: [usize; 3], lo: [f64; 3], hi: [f64; 3]) -> (Vec<[f64; 3]
 
     // The 6 Kuhn tets of the unit cube: path 0 -> e_s0 -> e_s0 + e_s1 -> (1,1,1) for every
     // permutation s; det = sign(s), odd permutations get vertices 1 and 2 swapped.
-    const PERMS: [([usize; 3], bool); 6] = [
-        ([0, 1, 2], true),
-        ([1, 2, 0], true),
-        ([2, 0, 1], true),
-        ([0, 2, 1], false),
-        ([2, 1, 0], false),
-        ([1, 0, 2], false),
-    ];
+    const PERMS: [([usize; 3], bool); 6] =
+        [([0, 1, 2], true), ([1, 2, 0], true), ([2, 0, 1], true), ([0, 2, 1], false), ([2, 1, 0], false), ([1, 0, 2], false)];
     let mut local: [[[usize; 3]; 4]; 6] = [[[0; 3]; 4]; 6];
     for (t, (s, even)) in PERMS.iter().enumerate() {
         let p0 = [0usize; 3];
@@ -64,11 +52,7 @@ pub fn kuhn_box_mesh(n: [usize; 3], lo: [f64; 3], hi: [f64; 3]) -> (Vec<[f64; 3]
         let mut p2 = p1;
         p2[s[1]] = 1;
         let p3 = [1usize; 3];
-        local[t] = if *even {
-            [p0, p1, p2, p3]
-        } else {
-            [p0, p2, p1, p3]
-        };
+        local[t] = if *even { [p0, p1, p2, p3] } else { [p0, p2, p1, p3] };
     }
 
     let mut tets = Vec::with_capacity(6 * n[0] * n[1] * n[2]);
@@ -84,11 +68,7 @@ pub fn kuhn_box_mesh(n: [usize; 3], lo: [f64; 3], hi: [f64; 3]) -> (Vec<[f64; 3]
                         fv[m] = [2 * i, 2 * j, 2 * k];
                     }
                     for (e, [a, b]) in TET_EDGES.iter().enumerate() {
-                        let fm = [
-                            (fv[*a][0] + fv[*b][0]) / 2,
-                            (fv[*a][1] + fv[*b][1]) / 2,
-                            (fv[*a][2] + fv[*b][2]) / 2,
-                        ];
+                        let fm = [(fv[*a][0] + fv[*b][0]) / 2, (fv[*a][1] + fv[*b][1]) / 2, (fv[*a][2] + fv[*b][2]) / 2];
                         let slot = &mut mid_id[fine(fm)];
                         if *slot == u32::MAX {
                             *slot = nodes.len() as u32;
@@ -129,15 +109,8 @@ mod tests {
                 let (ia, ib) = (t[*a], t[*b]);
                 let key = (ia.min(ib), ia.max(ib));
                 let m = t[4 + e];
-                assert!(
-                    m as usize >= 4 * 3 * 5,
-                    "midside node numbered among vertices"
-                );
-                assert_eq!(
-                    *edge_mid.entry(key).or_insert(m),
-                    m,
-                    "midside node not shared"
-                );
+                assert!(m as usize >= 4 * 3 * 5, "midside node numbered among vertices");
+                assert_eq!(*edge_mid.entry(key).or_insert(m), m, "midside node not shared");
                 for c in 0..3 {
                     let want = 0.5 * (nodes[ia as usize][c] + nodes[ib as usize][c]);
                     assert!((nodes[m as usize][c] - want).abs() < 1e-14);

@@ -10,11 +10,7 @@ const TET_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
 /// Builds the P2 mesh from the refined vertex mesh.
 pub(crate) fn assemble(b: Bisector, spec: &MeshSpec, h: f64) -> Mesh {
     let n_vertices = b.verts.len();
-    let vtets: Vec<[u32; 4]> = b
-        .tets
-        .iter()
-        .map(|t| orient_positive(&b.verts, *t))
-        .collect();
+    let vtets: Vec<[u32; 4]> = b.tets.iter().map(|t| orient_positive(&b.verts, *t)).collect();
     let mut nodes = b.verts;
     let (tets, edge_nodes) = add_edge_nodes(&mut nodes, &vtets);
     let (contact_tris, contact_tri_tet) = contact_triangles(&nodes, &tets, &edge_nodes, spec);
@@ -24,22 +20,8 @@ pub(crate) fn assemble(b: Bisector, spec: &MeshSpec, h: f64) -> Mesh {
     let (lo, hi) = spec.bounds();
     let tol = 1e-12 * spec.cube_edge.max(spec.depth);
     let clamped = nodes.iter().map(|p| (p[1] - lo[1]).abs() <= tol).collect();
-    let symmetry = nodes
-        .iter()
-        .map(|p| spec.half_z && (p[2] - hi[2]).abs() <= tol)
-        .collect();
-    Mesh {
-        nodes,
-        n_vertices,
-        tets,
-        contact_tris,
-        contact_tri_tet,
-        contact_nodes,
-        clamped,
-        symmetry,
-        contact_size: h,
-        spec: spec.clone(),
-    }
+    let symmetry = nodes.iter().map(|p| spec.half_z && (p[2] - hi[2]).abs() <= tol).collect();
+    Mesh { nodes, n_vertices, tets, contact_tris, contact_tri_tet, contact_nodes, clamped, symmetry, contact_size: h, spec: spec.clone() }
 }
 
 /// Swaps `v0` and `v1` if needed so that `det[v1-v0, v2-v0, v3-v0] > 0`.
@@ -77,12 +59,7 @@ fn add_edge_nodes(nodes: &mut Vec<[f64; 3]>, vtets: &[[u32; 4]]) -> (Vec<[u32; 1
 /// Top-face (`y = 0`) triangles lying in the contact rectangle, as P2
 /// triangles `v0, v1, v2, mid(0,1), mid(1,2), mid(2,0)` with positive
 /// orientation in the `(x, z)` plane, plus the owning tet of each.
-fn contact_triangles(
-    nodes: &[[f64; 3]],
-    tets: &[[u32; 10]],
-    edge_nodes: &U64Map<u32>,
-    spec: &MeshSpec,
-) -> (Vec<[u32; 6]>, Vec<u32>) {
+fn contact_triangles(nodes: &[[f64; 3]], tets: &[[u32; 10]], edge_nodes: &U64Map<u32>, spec: &MeshSpec) -> (Vec<[u32; 6]>, Vec<u32>) {
     let tol = 1e-12 * spec.cube_edge;
     let on_contact = |i: u32| {
         let p = nodes[i as usize];
@@ -96,14 +73,7 @@ fn contact_triangles(
             if v.iter().all(|&i| on_contact(i)) {
                 let v = orient_xz(nodes, v);
                 let m = |a: u32, b: u32| edge_nodes[&edge_key(a, b)];
-                tris.push([
-                    v[0],
-                    v[1],
-                    v[2],
-                    m(v[0], v[1]),
-                    m(v[1], v[2]),
-                    m(v[2], v[0]),
-                ]);
+                tris.push([v[0], v[1], v[2], m(v[0], v[1]), m(v[1], v[2]), m(v[2], v[0])]);
                 owner.push(ti as u32);
             }
         }

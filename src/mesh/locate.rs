@@ -38,14 +38,7 @@ impl ContactLocator {
         let h = mesh.contact_size;
         let nx = ((r.x1 - r.x0) / h).round().max(1.0) as usize;
         let nz = ((r.z1 - r.z0) / h).round().max(1.0) as usize;
-        let mut loc = ContactLocator {
-            x0: r.x0,
-            z0: r.z0,
-            h,
-            nx,
-            nz,
-            cells: vec![Vec::new(); nx * nz],
-        };
+        let mut loc = ContactLocator { x0: r.x0, z0: r.z0, h, nx, nz, cells: vec![Vec::new(); nx * nz] };
         for (k, c) in mesh.contact_tris.iter().enumerate() {
             let p = [c[0], c[1], c[2]].map(|i| mesh.nodes[i as usize]);
             let (i0, i1) = loc.range(p.iter().map(|q| q[0]), loc.x0, nx);
@@ -77,10 +70,7 @@ impl ContactLocator {
         if !r.contains(x, z, BARY_TOL * self.h) {
             return None;
         }
-        let (i, j) = (
-            self.cell(x, self.x0, self.nx),
-            self.cell(z, self.z0, self.nz),
-        );
+        let (i, j) = (self.cell(x, self.x0, self.nx), self.cell(z, self.z0, self.nz));
         self.cells[i + self.nx * j].iter().find_map(|&k| {
             let l = mesh.contact_barycentric(k as usize, x, z);
             inside(&l).then_some((k as usize, l))

@@ -18,13 +18,13 @@
 //! `h_c = 16 / 2^L` (see [`MeshSpec::actual_contact_size`]).
 
 mod assemble;
+pub mod face;
 mod locate;
 mod partition;
 mod quality;
 mod refine;
 pub mod size_field;
 pub mod spec;
-pub mod face;
 
 #[cfg(test)]
 mod tests;
@@ -149,9 +149,7 @@ impl Mesh {
 
     /// Total area of the contact triangles (equals the rectangle's area).
     pub fn top_face_area_in_contact(&self) -> f64 {
-        (0..self.contact_tris.len())
-            .map(|k| self.contact_tri_area(k))
-            .sum()
+        (0..self.contact_tris.len()).map(|k| self.contact_tri_area(k)).sum()
     }
 
     /// The contact triangle containing `(x, z)` and the barycentric

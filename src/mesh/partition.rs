@@ -91,11 +91,7 @@ pub fn partition(mesh: &Mesh, nranks: usize) -> Partition {
     let node_keys: Vec<u64> = mesh.nodes.iter().map(|p| point_key(p, &lo, &hi)).collect();
     let mut node_order: Vec<u32> = (0..mesh.nodes.len() as u32).collect();
     node_order.sort_unstable_by_key(|&i| (node_rank[i as usize], node_keys[i as usize], i));
-    Partition {
-        tet_rank,
-        node_rank,
-        node_order,
-    }
+    Partition { tet_rank, node_rank, node_order }
 }
 
 #[cfg(test)]

@@ -16,11 +16,7 @@ pub struct Quality {
 
 /// Cross product.
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// Dot product.
@@ -56,24 +52,13 @@ pub fn tet_quality(p: &[[f64; 3]; 4]) -> (f64, f64, f64) {
     let vol = det6([&p[0], &p[1], &p[2], &p[3]]) / 6.0;
     let area: f64 = norm.iter().sum::<f64>() * 0.5;
     let r_in = 3.0 * vol.abs() / area;
-    let h_max = TET_EDGES
-        .iter()
-        .map(|&(a, b)| dist(&p[a], &p[b]))
-        .fold(0.0, f64::max);
-    (
-        min_angle.to_degrees(),
-        h_max / (2.0 * 6f64.sqrt() * r_in),
-        vol,
-    )
+    let h_max = TET_EDGES.iter().map(|&(a, b)| dist(&p[a], &p[b])).fold(0.0, f64::max);
+    (min_angle.to_degrees(), h_max / (2.0 * 6f64.sqrt() * r_in), vol)
 }
 
 /// Worst-case quality over all tets of `mesh`.
 pub fn quality(mesh: &Mesh) -> Quality {
-    let mut q = Quality {
-        min_dihedral_deg: f64::INFINITY,
-        max_aspect_ratio: 0.0,
-        min_volume: f64::INFINITY,
-    };
+    let mut q = Quality { min_dihedral_deg: f64::INFINITY, max_aspect_ratio: 0.0, min_volume: f64::INFINITY };
     for t in 0..mesh.tets.len() {
         let (a, r, v) = tet_quality(&mesh.tet_corners(t));
         q.min_dihedral_deg = q.min_dihedral_deg.min(a);
@@ -90,13 +75,7 @@ mod tests {
     #[test]
     fn regular_tet() {
         let s = 1.0 / 2f64.sqrt();
-        let p = [
-            [1.0, 1.0, 1.0],
-            [1.0, -1.0, -1.0],
-            [-1.0, 1.0, -1.0],
-            [-1.0, -1.0, 1.0],
-        ]
-        .map(|v| v.map(|c| c * s));
+        let p = [[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]].map(|v| v.map(|c| c * s));
         let (a, r, v) = tet_quality(&p);
         assert!((a - (1.0f64 / 3.0).acos().to_degrees()).abs() < 1e-12);
         assert!((r - 1.0).abs() < 1e-12);
@@ -125,12 +104,7 @@ mod tests {
     #[test]
     fn kuhn_tet_angles() {
         // Kuhn tet of the unit cube: dihedral angles 45, 60, 90 degrees.
-        let p = [
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [1.0, 1.0, 0.0],
-            [1.0, 1.0, 1.0],
-        ];
+        let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 1.0, 1.0]];
         let (a, _, v) = tet_quality(&p);
         assert!((a - 45.0).abs() < 1e-12);
         assert!((v - 1.0 / 6.0).abs() < 1e-15);

@@ -62,14 +62,7 @@ pub(crate) struct Bisector {
 }
 
 /// The six Kuhn paths: permutations of the axes.
-const KUHN_PERMS: [[usize; 3]; 6] = [
-    [0, 1, 2],
-    [0, 2, 1],
-    [1, 0, 2],
-    [1, 2, 0],
-    [2, 0, 1],
-    [2, 1, 0],
-];
+const KUHN_PERMS: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
 
 impl Bisector {
     /// Kuhn triangulation of the tensor grid with the given breakpoints:
@@ -138,9 +131,7 @@ impl Bisector {
     /// True if some edge of leaf `i` has been bisected (hanging node).
     pub fn has_hanging(&self, i: usize) -> bool {
         let t = self.tets[i];
-        TET_EDGES
-            .iter()
-            .any(|&(a, b)| self.mids.contains_key(&edge_key(t[a], t[b])))
+        TET_EDGES.iter().any(|&(a, b)| self.mids.contains_key(&edge_key(t[a], t[b])))
     }
 
     /// Bisects (recursively) every leaf for which `marked` holds; returns
@@ -190,10 +181,7 @@ impl Bisector {
 
 /// Longest edge length of a tetrahedron.
 pub(crate) fn longest_edge(v: &[[f64; 3]], t: &[u32; 4]) -> f64 {
-    TET_EDGES
-        .iter()
-        .map(|&(a, b)| dist(&v[t[a] as usize], &v[t[b] as usize]))
-        .fold(0.0, f64::max)
+    TET_EDGES.iter().map(|&(a, b)| dist(&v[t[a] as usize], &v[t[b] as usize])).fold(0.0, f64::max)
 }
 
 /// Euclidean distance.
@@ -214,7 +202,9 @@ pub(crate) fn bbox_distance(v: &[[f64; 3]], t: &[u32; 4], lo: &[f64; 3], hi: &[f
 
 /// Coordinate ranges `(min, max)` of tet `t` along x, y and z (its bounding box).
 pub(crate) fn tet_ranges(v: &[[f64; 3]], t: &[u32; 4]) -> [(f64, f64); 3] {
-    std::array::from_fn(|c| t.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| (lo.min(v[i as usize][c]), hi.max(v[i as usize][c]))))
+    std::array::from_fn(|c| {
+        t.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| (lo.min(v[i as usize][c]), hi.max(v[i as usize][c])))
+    })
 }
 
 /// Distance from the bounding box of tet `t` to the annulus
@@ -222,7 +212,15 @@ pub(crate) fn tet_ranges(v: &[[f64; 3]], t: &[u32; 4]) -> [(f64, f64); 3] {
 /// radius is continuous over the box's (x, z) rectangle, and y is independent).
 pub(crate) fn ring_distance(v: &[[f64; 3]], t: &[u32; 4], r0: f64, r1: f64) -> f64 {
     let [(x0, x1), (y0, y1), (z0, z1)] = tet_ranges(v, t);
-    let near = |a: f64, b: f64| if a > 0.0 { a } else if b < 0.0 { -b } else { 0.0 };
+    let near = |a: f64, b: f64| {
+        if a > 0.0 {
+            a
+        } else if b < 0.0 {
+            -b
+        } else {
+            0.0
+        }
+    };
     let far = |a: f64, b: f64| a.abs().max(b.abs());
     let rmin = near(x0, x1).hypot(near(z0, z1));
     let rmax = far(x0, x1).hypot(far(z0, z1));
@@ -235,8 +233,7 @@ pub(crate) fn ring_distance(v: &[[f64; 3]], t: &[u32; 4], r0: f64, r1: f64) -> f
 pub(crate) fn det6(p: [&[f64; 3]; 4]) -> f64 {
     let d = |a: &[f64; 3]| [a[0] - p[0][0], a[1] - p[0][1], a[2] - p[0][2]];
     let (a, b, c) = (d(p[1]), d(p[2]), d(p[3]));
-    a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-        + a[2] * (b[0] * c[1] - b[1] * c[0])
+    a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])
 }
 
 #[cfg(test)]
@@ -248,10 +245,7 @@ mod tests {
     }
 
     fn volume(b: &Bisector) -> f64 {
-        b.tets
-            .iter()
-            .map(|t| det6(t.map(|i| &b.verts[i as usize])).abs() / 6.0)
-            .sum()
+        b.tets.iter().map(|t| det6(t.map(|i| &b.verts[i as usize])).abs() / 6.0).sum()
     }
 
     #[test]
@@ -263,10 +257,7 @@ mod tests {
             let v = det6(t.map(|i| &b.verts[i as usize])).abs() / 6.0;
             assert!((v - 1.0 / 6.0).abs() < 1e-15);
             // refinement edge x0-x3 is the main diagonal
-            assert!(
-                (dist(&b.verts[t[0] as usize], &b.verts[t[3] as usize]) - 3f64.sqrt()).abs()
-                    < 1e-15
-            );
+            assert!((dist(&b.verts[t[0] as usize], &b.verts[t[3] as usize]) - 3f64.sqrt()).abs() < 1e-15);
         }
     }
 
@@ -324,9 +315,7 @@ mod tests {
     fn closure_removes_hanging_nodes() {
         let mut b = Bisector::kuhn(&[vec![0.0, 1.0, 2.0], vec![0.0, 1.0], vec![0.0, 1.0, 2.0]]);
         // refine near a corner repeatedly
-        b.refine_and_close(|v, t| {
-            bbox_distance(v, t, &[0.0; 3], &[0.0; 3]) < 1e-12 && longest_edge(v, t) > 0.2
-        });
+        b.refine_and_close(|v, t| bbox_distance(v, t, &[0.0; 3], &[0.0; 3]) < 1e-12 && longest_edge(v, t) > 0.2);
         assert!((0..b.tets.len()).all(|i| !b.has_hanging(i)));
         assert!((volume(&b) - 4.0).abs() < 1e-13);
     }
@@ -346,12 +335,7 @@ mod tests {
 
     #[test]
     fn bbox_distance_cases() {
-        let v = vec![
-            [1.0, -1.0, 0.0],
-            [2.0, -1.0, 0.0],
-            [1.0, -2.0, 0.0],
-            [1.0, -1.0, 1.0],
-        ];
+        let v = vec![[1.0, -1.0, 0.0], [2.0, -1.0, 0.0], [1.0, -2.0, 0.0], [1.0, -1.0, 1.0]];
         let t = [0, 1, 2, 3];
         let d = bbox_distance(&v, &t, &[-1.0, 0.0, -1.0], &[0.0, 0.0, 2.0]);
         assert!((d - 2f64.sqrt()).abs() < 1e-15);

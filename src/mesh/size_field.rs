@@ -27,7 +27,15 @@ pub struct SizeField {
 
 impl std::fmt::Debug for SizeField {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "SizeField({}x{} cells of {} a, sizes {}..{} a)", self.nx, self.nz, self.step, self.min_size, self.size.iter().cloned().fold(0.0, f64::max))
+        write!(
+            f,
+            "SizeField({}x{} cells of {} a, sizes {}..{} a)",
+            self.nx,
+            self.nz,
+            self.step,
+            self.min_size,
+            self.size.iter().cloned().fold(0.0, f64::max)
+        )
     }
 }
 

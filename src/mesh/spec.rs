@@ -106,12 +106,7 @@ impl MeshSpec {
             cube_edge: 60.0,
             depth: 60.0,
             half_z: false,
-            contact: Rect {
-                x0: -3.0,
-                x1: 3.0,
-                z0: -3.0,
-                z1: 3.0,
-            },
+            contact: Rect { x0: -3.0, x1: 3.0, z0: -3.0, z1: 3.0 },
             contact_size: 0.25,
             growth: 0.5,
             core: None,
@@ -171,9 +166,7 @@ impl MeshSpec {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(format!(
-                    "mesh spec: {name} must be finite and > 0 (got {v})"
-                ))
+                Err(format!("mesh spec: {name} must be finite and > 0 (got {v})"))
             }
         };
         pos("cube_edge", self.cube_edge)?;
@@ -183,10 +176,7 @@ impl MeshSpec {
         if let Some(r) = self.ring {
             pos("ring size", r.size)?;
             if !(r.inner.is_finite() && r.outer.is_finite() && r.inner >= 0.0 && r.outer > r.inner) {
-                return Err(format!(
-                    "mesh spec: ring radii must satisfy 0 <= inner < outer (got inner {}, outer {})",
-                    r.inner, r.outer
-                ));
+                return Err(format!("mesh spec: ring radii must satisfy 0 <= inner < outer (got inner {}, outer {})", r.inner, r.outer));
             }
         }
         if let Some((r, size)) = self.patch {
@@ -201,10 +191,7 @@ impl MeshSpec {
             }
         }
         if self.contact_size < COARSE_CELL / f64::from(1u32 << MAX_LEVEL) {
-            return Err(format!(
-                "mesh spec: contact_size {} is below the minimum 16/2^{MAX_LEVEL}",
-                self.contact_size
-            ));
+            return Err(format!("mesh spec: contact_size {} is below the minimum 16/2^{MAX_LEVEL}", self.contact_size));
         }
         Ok(())
     }
@@ -216,9 +203,7 @@ impl MeshSpec {
     fn validate_rect(&self, h: f64) -> Result<(), String> {
         let r = self.contact;
         if !r.is_proper() {
-            return Err(format!(
-                "mesh spec: contact rectangle {r:?} is empty or not finite"
-            ));
+            return Err(format!("mesh spec: contact rectangle {r:?} is empty or not finite"));
         }
         let (lo, hi) = self.bounds();
         let tol = 1e-12 * self.cube_edge;
@@ -308,20 +293,11 @@ mod tests {
 
     #[test]
     fn breaks_match_examples() {
-        assert_eq!(
-            coarse_breaks(-30.0, 30.0, 16.0),
-            vec![-30.0, -16.0, 0.0, 16.0, 30.0]
-        );
-        assert_eq!(
-            coarse_breaks(-60.0, 0.0, 16.0),
-            vec![-60.0, -48.0, -32.0, -16.0, 0.0]
-        );
+        assert_eq!(coarse_breaks(-30.0, 30.0, 16.0), vec![-30.0, -16.0, 0.0, 16.0, 30.0]);
+        assert_eq!(coarse_breaks(-60.0, 0.0, 16.0), vec![-60.0, -48.0, -32.0, -16.0, 0.0]);
         assert_eq!(coarse_breaks(-30.0, 0.0, 16.0), vec![-30.0, -16.0, 0.0]);
         // remainder 2 < 8 merged with its neighbour
-        assert_eq!(
-            coarse_breaks(-34.0, 34.0, 16.0),
-            vec![-34.0, -16.0, 0.0, 16.0, 34.0]
-        );
+        assert_eq!(coarse_breaks(-34.0, 34.0, 16.0), vec![-34.0, -16.0, 0.0, 16.0, 34.0]);
         assert_eq!(coarse_breaks(-20.0, 0.0, 16.0), vec![-20.0, 0.0]);
     }
 
@@ -358,20 +334,10 @@ mod tests {
     fn validation_accepts_paper_cases() {
         let mut s = MeshSpec::paper_default();
         assert_eq!(s.validate(), Ok(0.25));
-        s.contact = Rect {
-            x0: -4.5,
-            x1: 1.5,
-            z0: -3.0,
-            z1: 3.0,
-        };
+        s.contact = Rect { x0: -4.5, x1: 1.5, z0: -3.0, z1: 3.0 };
         assert!(s.validate().is_ok());
         s.half_z = true;
-        s.contact = Rect {
-            x0: -3.0,
-            x1: 3.0,
-            z0: -3.0,
-            z1: 0.0,
-        };
+        s.contact = Rect { x0: -3.0, x1: 3.0, z0: -3.0, z1: 0.0 };
         assert!(s.validate().is_ok());
     }
 

@@ -16,12 +16,7 @@ fn default_mesh() -> &'static Mesh {
 /// Offset contact rectangle `[-4.5, 1.5] x [-3, 3]`.
 fn offset_spec() -> MeshSpec {
     let mut s = MeshSpec::paper_default();
-    s.contact = Rect {
-        x0: -4.5,
-        x1: 1.5,
-        z0: -3.0,
-        z1: 3.0,
-    };
+    s.contact = Rect { x0: -4.5, x1: 1.5, z0: -3.0, z1: 3.0 };
     s
 }
 
@@ -29,12 +24,7 @@ fn offset_spec() -> MeshSpec {
 fn half_spec() -> MeshSpec {
     let mut s = MeshSpec::paper_default();
     s.half_z = true;
-    s.contact = Rect {
-        x0: -3.0,
-        x1: 3.0,
-        z0: -3.0,
-        z1: 0.0,
-    };
+    s.contact = Rect { x0: -3.0, x1: 3.0, z0: -3.0, z1: 0.0 };
     s
 }
 
@@ -56,11 +46,7 @@ fn on_box_face(p: &[[f64; 3]; 3], lo: &[f64; 3], hi: &[f64; 3]) -> bool {
 fn tri_area(p: &[[f64; 3]; 3]) -> f64 {
     let u = [0, 1, 2].map(|c| p[1][c] - p[0][c]);
     let v = [0, 1, 2].map(|c| p[2][c] - p[0][c]);
-    let n = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
+    let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
     0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
 }
 
@@ -83,25 +69,15 @@ fn check_conformity(m: &Mesh) {
         let p = f.map(|i| m.nodes[i as usize]);
         match count {
             1 => {
-                assert!(
-                    on_box_face(&p, &lo, &hi),
-                    "boundary face {p:?} not on the box surface"
-                );
+                assert!(on_box_face(&p, &lo, &hi), "boundary face {p:?} not on the box surface");
                 boundary_area += tri_area(&p);
             }
             2 => assert!(!on_box_face(&p, &lo, &hi), "interior face on box surface"),
             _ => panic!("face {f:?} shared by {count} tets"),
         }
     }
-    assert!(
-        rel_close(boundary_area, m.spec.box_surface(), 1e-10),
-        "{boundary_area}"
-    );
-    assert!(
-        rel_close(m.volume(), m.spec.box_volume(), 1e-10),
-        "{}",
-        m.volume()
-    );
+    assert!(rel_close(boundary_area, m.spec.box_surface(), 1e-10), "{boundary_area}");
+    assert!(rel_close(m.volume(), m.spec.box_volume(), 1e-10), "{}", m.volume());
 }
 
 /// No vertex sits at the midpoint of a tet edge (geometric check).
@@ -128,19 +104,12 @@ fn check_p2(m: &Mesh) {
             let node = q[4 + e];
             assert!(node as usize >= m.n_vertices);
             let (pa, pb) = (m.nodes[q[a] as usize], m.nodes[q[b] as usize]);
-            assert_eq!(
-                m.nodes[node as usize],
-                [0, 1, 2].map(|c| 0.5 * (pa[c] + pb[c]))
-            );
+            assert_eq!(m.nodes[node as usize], [0, 1, 2].map(|c| 0.5 * (pa[c] + pb[c])));
             let prev = *edge_node.entry(edge_key(q[a], q[b])).or_insert(node);
             assert_eq!(prev, node, "edge node not shared");
         }
     }
-    assert_eq!(
-        edge_node.len(),
-        m.nodes.len() - m.n_vertices,
-        "unused or duplicate edge nodes"
-    );
+    assert_eq!(edge_node.len(), m.nodes.len() - m.n_vertices, "unused or duplicate edge nodes");
     let distinct: HashSet<u32> = edge_node.values().copied().collect();
     assert_eq!(distinct.len(), edge_node.len());
 }
@@ -150,10 +119,7 @@ fn check_p2(m: &Mesh) {
 fn check_contact(m: &Mesh) {
     let r = m.spec.contact;
     let h = m.contact_size;
-    let (nx, nz) = (
-        ((r.x1 - r.x0) / h).round() as usize,
-        ((r.z1 - r.z0) / h).round() as usize,
-    );
+    let (nx, nz) = (((r.x1 - r.x0) / h).round() as usize, ((r.z1 - r.z0) / h).round() as usize);
     assert_eq!(m.contact_tris.len(), 2 * nx * nz);
     assert!(rel_close(m.top_face_area_in_contact(), r.area(), 1e-12));
     let mut grid = HashSet::new();
@@ -161,10 +127,7 @@ fn check_contact(m: &Mesh) {
         assert!(m.contact_tri_area(k) > 0.0);
         let face: HashSet<u32> = c[..3].iter().copied().collect();
         let owner = &m.tets[m.contact_tri_tet[k] as usize];
-        assert!(
-            c.iter().all(|v| owner.contains(v)),
-            "triangle {k} not a face of its tet"
-        );
+        assert!(c.iter().all(|v| owner.contains(v)), "triangle {k} not a face of its tet");
         assert_eq!(face.len(), 3);
         for (i, &v) in c.iter().enumerate() {
             let p = m.nodes[v as usize];
@@ -172,20 +135,12 @@ fn check_contact(m: &Mesh) {
             assert!(r.contains(p[0], p[2], 0.0));
             if i < 3 {
                 let (ix, iz) = ((p[0] - r.x0) / h, (p[2] - r.z0) / h);
-                assert_eq!(
-                    (ix.fract(), iz.fract()),
-                    (0.0, 0.0),
-                    "vertex off the h_c grid"
-                );
+                assert_eq!((ix.fract(), iz.fract()), (0.0, 0.0), "vertex off the h_c grid");
                 grid.insert((ix as usize, iz as usize));
             }
         }
     }
-    assert_eq!(
-        grid.len(),
-        (nx + 1) * (nz + 1),
-        "contact vertex grid incomplete"
-    );
+    assert_eq!(grid.len(), (nx + 1) * (nz + 1), "contact vertex grid incomplete");
     let mut expect: Vec<u32> = m.contact_tris.iter().flatten().copied().collect();
     expect.sort_unstable();
     expect.dedup();
@@ -199,10 +154,7 @@ fn check_flags(m: &Mesh) {
     for (i, p) in m.nodes.iter().enumerate() {
         assert_eq!(m.clamped[i], p[1] == lo[1]);
         assert_eq!(m.symmetry[i], m.spec.half_z && p[2] == 0.0);
-        assert_eq!(
-            p[2] == hi[2],
-            m.symmetry[i] || !m.spec.half_z && p[2] == hi[2]
-        );
+        assert_eq!(p[2] == hi[2], m.symmetry[i] || !m.spec.half_z && p[2] == hi[2]);
     }
     assert!(m.clamped.iter().any(|&c| c));
 }
@@ -247,9 +199,7 @@ fn no_hanging_nodes_in_edge_map() {
         let r = spec.contact;
         for t in &b.tets {
             let d = bbox_distance(&b.verts, t, &[r.x0, 0.0, r.z0], &[r.x1, 0.0, r.z1]);
-            assert!(
-                longest_edge(&b.verts, t) <= 3f64.sqrt() * (h + spec.growth * d) * (1.0 + 1e-9)
-            );
+            assert!(longest_edge(&b.verts, t) <= 3f64.sqrt() * (h + spec.growth * d) * (1.0 + 1e-9));
         }
     }
 }
@@ -259,9 +209,7 @@ fn default_has_vertex_at_x_equals_a() {
     let m = default_mesh();
     let (k, l) = m.locate_contact(1.0, 0.0).unwrap();
     let c = &m.contact_tris[k];
-    let hit = (0..3)
-        .find(|&i| (l[i] - 1.0).abs() < 1e-12)
-        .expect("(1,0) is not a vertex");
+    let hit = (0..3).find(|&i| (l[i] - 1.0).abs() < 1e-12).expect("(1,0) is not a vertex");
     assert_eq!(m.nodes[c[hit] as usize], [1.0, 0.0, 0.0]);
     assert!(m.nodes[..m.n_vertices].contains(&[1.0, 0.0, 0.25]));
 }
@@ -276,11 +224,7 @@ fn half_domain_mesh_is_valid() {
     let m = generate(&half_spec()).unwrap();
     check_all(&m);
     let zmin = m.nodes.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
-    let zmax = m
-        .nodes
-        .iter()
-        .map(|p| p[2])
-        .fold(f64::NEG_INFINITY, f64::max);
+    let zmax = m.nodes.iter().map(|p| p[2]).fold(f64::NEG_INFINITY, f64::max);
     assert_eq!((zmin, zmax), (-30.0, 0.0));
     assert!(rel_close(m.volume(), 60.0 * 60.0 * 30.0, 1e-12));
     // every node on z = 0 flagged, including contact nodes on the symmetry edge
@@ -325,12 +269,7 @@ fn generation_is_deterministic() {
 fn coarse_mesh_without_contact_refinement() {
     // h_c = 16: no refinement near R beyond the coarse grid; still valid.
     let mut s = MeshSpec::paper_default();
-    s.contact = Rect {
-        x0: -16.0,
-        x1: 16.0,
-        z0: -16.0,
-        z1: 16.0,
-    };
+    s.contact = Rect { x0: -16.0, x1: 16.0, z0: -16.0, z1: 16.0 };
     s.contact_size = 16.0;
     s.growth = 10.0;
     let m = generate(&s).unwrap();
@@ -370,9 +309,7 @@ fn locate_contact_finds_points() {
     let loc = ContactLocator::new(m);
     let mut s = 12345u64;
     let mut rnd = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (s >> 11) as f64 / (1u64 << 53) as f64
     };
     for _ in 0..500 {
@@ -385,10 +322,7 @@ fn locate_contact_finds_points() {
         assert!((xr - x).abs() < 1e-12 && (zr - z).abs() < 1e-12);
         let (k2, l2) = loc.locate(m, x, z).unwrap();
         assert!(l2.iter().all(|&v| v >= -1e-12));
-        assert!(
-            k2 == k || l.iter().any(|&v| v.abs() < 1e-12),
-            "locator disagrees inside"
-        );
+        assert!(k2 == k || l.iter().any(|&v| v.abs() < 1e-12), "locator disagrees inside");
     }
     assert!(m.locate_contact(3.5, 0.0).is_none());
     assert!(loc.locate(m, 0.0, -3.5).is_none());
@@ -416,10 +350,7 @@ fn check_partition(m: &Mesh, nranks: usize) {
         assert!(!std::mem::replace(&mut seen[v as usize], true));
     }
     assert!(seen.iter().all(|&s| s));
-    assert!(p
-        .node_order
-        .windows(2)
-        .all(|w| p.node_rank[w[0] as usize] <= p.node_rank[w[1] as usize]));
+    assert!(p.node_order.windows(2).all(|w| p.node_rank[w[0] as usize] <= p.node_rank[w[1] as usize]));
     assert_eq!(p, partition(m, nranks), "not deterministic");
 }
 
@@ -446,13 +377,8 @@ fn report() {
         s.contact_size = h;
         (format!("h_c={h}"), s)
     };
-    let cases = [
-        sized(0.25),
-        sized(0.125),
-        sized(0.0625),
-        ("offset R".to_string(), offset_spec()),
-        ("half domain".to_string(), half_spec()),
-    ];
+    let cases =
+        [sized(0.25), sized(0.125), sized(0.0625), ("offset R".to_string(), offset_spec()), ("half domain".to_string(), half_spec())];
     for (name, s) in cases {
         let t0 = Instant::now();
         let m = generate(&s).unwrap();

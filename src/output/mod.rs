@@ -149,7 +149,8 @@ impl OutputClaim {
 /// `staging`.
 pub fn publish(staging: &Path, dir: &Path) -> Result<(), String> {
     let err = |e: std::io::Error| format!("cannot move the results from {} to {}: {e}", staging.display(), dir.display());
-    let mut names: Vec<std::ffi::OsString> = std::fs::read_dir(staging).map_err(err)?.filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    let mut names: Vec<std::ffi::OsString> =
+        std::fs::read_dir(staging).map_err(err)?.filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
     names.sort_by_key(|n| n == "summary.json");
     let _ = std::fs::remove_file(dir.join("summary.json"));
     for n in names {

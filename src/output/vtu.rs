@@ -85,10 +85,7 @@ pub fn write_vtu_single_type(
 ) -> io::Result<()> {
     let npc = nodes_per_cell(cell_type).ok_or_else(|| invalid(format!("vtu: unsupported VTK cell type {cell_type}")))?;
     if connectivity.len() % npc != 0 {
-        return Err(invalid(format!(
-            "vtu: connectivity length {} is not a multiple of {npc} (cell type {cell_type})",
-            connectivity.len()
-        )));
+        return Err(invalid(format!("vtu: connectivity length {} is not a multiple of {npc} (cell type {cell_type})", connectivity.len())));
     }
     let ncells = connectivity.len() / npc;
     let offsets: Vec<i64> = (1..=ncells).map(|i| (i * npc) as i64).collect();
@@ -174,9 +171,7 @@ fn write_raw(
     let mut app = Appended { bytes: Vec::with_capacity(8 * (3 * npoints + conn.len() + 2 * ncells) + 64) };
     let mut xml = String::new();
     xml.push_str("<?xml version=\"1.0\"?>\n");
-    xml.push_str(
-        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n",
-    );
+    xml.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
     xml.push_str("  <UnstructuredGrid>\n");
     xml.push_str(&format!("    <Piece NumberOfPoints=\"{npoints}\" NumberOfCells=\"{ncells}\">\n"));
 

@@ -78,7 +78,15 @@ impl Matrix {
         if vals.len() != rows.len() * cols.len() {
             return Err(rust_error(format!("Matrix::{what}: block size mismatch")));
         }
-        pcall!(ffi::MatSetValues(self.raw, rows.len() as ffi::PetscInt, rows.as_ptr(), cols.len() as ffi::PetscInt, cols.as_ptr(), vals.as_ptr(), mode))
+        pcall!(ffi::MatSetValues(
+            self.raw,
+            rows.len() as ffi::PetscInt,
+            rows.as_ptr(),
+            cols.len() as ffi::PetscInt,
+            cols.as_ptr(),
+            vals.as_ptr(),
+            mode
+        ))
     }
 
     /// The (rows, columns) block of a dense matrix whose entries this rank stores: for

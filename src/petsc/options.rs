@@ -20,7 +20,11 @@ static OURS: std::sync::Mutex<std::collections::BTreeSet<String>> = std::sync::M
 
 fn set_value(name: &str, value: &str) -> Result<()> {
     let (n, v) = (cstr(name), cstr(value));
-    pcall!(super::ffi::PetscOptionsSetValue(std::ptr::null_mut(), n.as_ptr(), if value.is_empty() { std::ptr::null() } else { v.as_ptr() }))?;
+    pcall!(super::ffi::PetscOptionsSetValue(
+        std::ptr::null_mut(),
+        n.as_ptr(),
+        if value.is_empty() { std::ptr::null() } else { v.as_ptr() }
+    ))?;
     OURS.lock().unwrap_or_else(|e| e.into_inner()).insert(name.to_string());
     Ok(())
 }
@@ -81,7 +85,15 @@ impl Group {
     pub fn bool(&mut self, name: &str, help: &str, default: bool) -> Result<bool> {
         let (n, h, m) = (cstr(name), cstr(help), cstr("EhlOptions"));
         let mut v: super::ffi::PetscBool = default as super::ffi::PetscBool;
-        pcall!(super::ffi::PetscOptionsBool_Private(&mut *self.items, n.as_ptr(), h.as_ptr(), m.as_ptr(), default as super::ffi::PetscBool, &mut v, std::ptr::null_mut()))?;
+        pcall!(super::ffi::PetscOptionsBool_Private(
+            &mut *self.items,
+            n.as_ptr(),
+            h.as_ptr(),
+            m.as_ptr(),
+            default as super::ffi::PetscBool,
+            &mut v,
+            std::ptr::null_mut()
+        ))?;
         Ok(v != 0)
     }
 
@@ -97,7 +109,17 @@ impl Group {
     pub fn int(&mut self, name: &str, help: &str, default: i32) -> Result<Option<i32>> {
         let (n, h, m) = (cstr(name), cstr(help), cstr("EhlOptions"));
         let (mut v, mut set) = (default, 0 as super::ffi::PetscBool);
-        pcall!(super::ffi::PetscOptionsInt_Private(&mut *self.items, n.as_ptr(), h.as_ptr(), m.as_ptr(), default, &mut v, &mut set, i32::MIN, i32::MAX))?;
+        pcall!(super::ffi::PetscOptionsInt_Private(
+            &mut *self.items,
+            n.as_ptr(),
+            h.as_ptr(),
+            m.as_ptr(),
+            default,
+            &mut v,
+            &mut set,
+            i32::MIN,
+            i32::MAX
+        ))?;
         Ok((set != 0).then_some(v))
     }
 
@@ -106,7 +128,16 @@ impl Group {
         let (n, h, m, d) = (cstr(name), cstr(help), cstr("EhlOptions"), cstr(default));
         let mut buf = vec![0 as std::os::raw::c_char; 4096];
         let mut set: super::ffi::PetscBool = 0;
-        pcall!(super::ffi::PetscOptionsString_Private(&mut *self.items, n.as_ptr(), h.as_ptr(), m.as_ptr(), d.as_ptr(), buf.as_mut_ptr(), buf.len(), &mut set))?;
+        pcall!(super::ffi::PetscOptionsString_Private(
+            &mut *self.items,
+            n.as_ptr(),
+            h.as_ptr(),
+            m.as_ptr(),
+            d.as_ptr(),
+            buf.as_mut_ptr(),
+            buf.len(),
+            &mut set
+        ))?;
         Ok((set != 0).then(|| unsafe { std::ffi::CStr::from_ptr(buf.as_ptr()) }.to_string_lossy().into_owned()))
     }
 

@@ -1,7 +1,7 @@
 //! PETSc start and finish on rsmpi's world communicator.
 use super::error::{check, record_error, Result};
 use super::ffi;
-use std::ffi::{CString, CStr};
+use std::ffi::{CStr, CString};
 use std::os::raw::c_char;
 
 /// An initialised PETSc. Create it after `mpi::initialize()` and drop it before the rsmpi
@@ -16,10 +16,7 @@ impl Petsc {
     /// Initialises PETSc with the given command-line arguments (program name first, then
     /// PETSc options such as `-ksp_view`). `PETSC_OPTIONS` from the environment also applies.
     pub fn init(args: &[String]) -> Result<Petsc> {
-        let args: Vec<CString> = args
-            .iter()
-            .map(|a| CString::new(a.as_str()).unwrap_or_else(|_| CString::new("?").unwrap()))
-            .collect();
+        let args: Vec<CString> = args.iter().map(|a| CString::new(a.as_str()).unwrap_or_else(|_| CString::new("?").unwrap())).collect();
         let mut argv: Vec<*mut c_char> = args.iter().map(|a| a.as_ptr() as *mut c_char).collect();
         argv.push(std::ptr::null_mut());
         let mut argc = args.len() as i32;

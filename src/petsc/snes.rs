@@ -119,7 +119,13 @@ unsafe extern "C" fn form_jacobian(_snes: ffi::SNES, x: ffi::Vec, j: ffi::Mat, _
     }
 }
 
-unsafe extern "C" fn precheck(_ls: ffi::SNESLineSearch, x: ffi::Vec, y: ffi::Vec, changed: *mut ffi::PetscBool, ctx: *mut c_void) -> ffi::PetscErrorCode {
+unsafe extern "C" fn precheck(
+    _ls: ffi::SNESLineSearch,
+    x: ffi::Vec,
+    y: ffi::Vec,
+    changed: *mut ffi::PetscBool,
+    ctx: *mut c_void,
+) -> ffi::PetscErrorCode {
     let ctx = &mut *(ctx as *mut Context);
     let run = || -> Result<bool> {
         let xv = std::mem::ManuallyDrop::new(Vector { raw: x });

@@ -27,12 +27,7 @@ impl FilmGroups {
     /// Groups for a circular contact (k = 1) from load (N), mean speed Ue (m/s), eta_0
     /// (Pa.s), alpha (1/Pa), E' (Pa), R_x (m).
     pub fn circular(load: f64, ue: f64, eta0: f64, alpha: f64, e_prime: f64, rx: f64) -> Self {
-        FilmGroups {
-            u: eta0 * ue / (e_prime * rx),
-            g: alpha * e_prime,
-            w: load / (e_prime * rx * rx),
-            k: 1.0,
-        }
+        FilmGroups { u: eta0 * ue / (e_prime * rx), g: alpha * e_prime, w: load / (e_prime * rx * rx), k: 1.0 }
     }
 }
 
@@ -75,10 +70,7 @@ impl HamrockDowson {
     /// Circular contact (k = 1): load (N), mean speed Ue (m/s), eta_0 (Pa.s), alpha (1/Pa),
     /// E' (Pa), R_x (m).
     pub fn circular(load: f64, ue: f64, eta0: f64, alpha: f64, e_prime: f64, rx: f64) -> Self {
-        HamrockDowson {
-            groups: FilmGroups::circular(load, ue, eta0, alpha, e_prime, rx),
-            rx,
-        }
+        HamrockDowson { groups: FilmGroups::circular(load, ue, eta0, alpha, e_prime, rx), rx }
     }
     /// Central film thickness h_c (m).
     pub fn central_film_thickness(&self) -> f64 {
@@ -103,10 +95,7 @@ mod tests {
     fn central_matches_paper_table2() {
         for (ue, paper_um) in [(1.0, 0.25), (2.0, 0.40), (3.0, 0.52)] {
             let hc = table1(ue).central_film_thickness() * 1e6;
-            assert!(
-                (hc - paper_um).abs() < 0.01,
-                "Ue = {ue}: hc = {hc} um, paper {paper_um}"
-            );
+            assert!((hc - paper_um).abs() < 0.01, "Ue = {ue}: hc = {hc} um, paper {paper_um}");
         }
     }
 
@@ -133,12 +122,7 @@ mod tests {
     fn isoviscous_rigid_circular() {
         // alpha_r = 1: lambda_b = 0.6, c = 0.131 atan(0.5) + 1.683 = 1.743738,
         // H_hat = 128 * 0.36 * 1.743738^2 = 140.1118
-        let f = FilmGroups {
-            u: 1e-11,
-            g: 0.0,
-            w: 1e-7,
-            k: 1.0,
-        };
+        let f = FilmGroups { u: 1e-11, g: 0.0, w: 1e-7, k: 1.0 };
         let h = isoviscous_rigid_minimum(&f, 1.0);
         assert!(rel(h / (1e-11f64 / 1e-7).powi(2), 140.1118) < 1e-6);
     }

@@ -56,10 +56,7 @@ pub fn equivalent_solid(b: Material, d: Material) -> Material {
     let a = b.plane_strain_compliance() + d.plane_strain_compliance();
     let bb = (1.0 + b.nu) / b.e + (1.0 + d.nu) / d.e;
     let nu = 1.0 - a / bb;
-    Material {
-        e: (1.0 + nu) / bb,
-        nu,
-    }
+    Material { e: (1.0 + nu) / bb, nu }
 }
 
 /// The dry Hertz solution of a ball of radius R on a flat disc (circular contact).
@@ -88,13 +85,7 @@ impl Hertz {
     pub fn from_reduced_modulus(load: f64, radius: f64, e_prime: f64) -> Self {
         let a = (3.0 * load * radius / (2.0 * e_prime)).cbrt();
         let ph = 3.0 * load / (2.0 * PI * a * a);
-        Hertz {
-            a,
-            ph,
-            e_prime,
-            load,
-            radius,
-        }
+        Hertz { a, ph, e_prime, load, radius }
     }
 
     /// Hertz pressure p(x, z) = p_H sqrt(1 - (x^2 + z^2)/a^2) inside the contact, 0 outside
@@ -169,11 +160,7 @@ mod tests {
 
     #[test]
     fn equivalent_solid_poisson_bounded() {
-        for &(e1, n1, e2, n2) in &[
-            (1e9, 0.49, 300e9, -0.5),
-            (5e6, 0.499, 1e12, 0.0),
-            (70e9, 0.33, 2e9, 0.45),
-        ] {
+        for &(e1, n1, e2, n2) in &[(1e9, 0.49, 300e9, -0.5), (5e6, 0.499, 1e12, 0.0), (70e9, 0.33, 2e9, 0.45)] {
             let eq = equivalent_solid(Material::new(e1, n1), Material::new(e2, n2));
             assert!(eq.nu < 0.5 && eq.nu >= n1.min(n2) - 1e-12 && eq.nu <= n1.max(n2) + 1e-12);
             assert!(eq.e > 0.0);

@@ -31,10 +31,9 @@ pub enum KinematicsError {
 impl fmt::Display for KinematicsError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            KinematicsError::ZeroTilt => write!(
-                f,
-                "tilt angle lambda = 0 is singular: the ball spin omega_B = U_BO/(R_B sin lambda) is infinite"
-            ),
+            KinematicsError::ZeroTilt => {
+                write!(f, "tilt angle lambda = 0 is singular: the ball spin omega_B = U_BO/(R_B sin lambda) is infinite")
+            }
             KinematicsError::TiltOutOfRange(l) => {
                 write!(f, "tilt angle lambda = {} deg is outside (0, 90] deg", l.to_degrees())
             }
@@ -106,13 +105,7 @@ pub struct Kinematics {
 impl Kinematics {
     /// Full kinematics with spin: Ue (m/s), SRR (fraction), lambda (rad, in (0, pi/2]),
     /// R_B and R_D (m). lambda = 0 is rejected ([`KinematicsError::ZeroTilt`]).
-    pub fn new(
-        ue: f64,
-        srr: f64,
-        lambda_rad: f64,
-        r_b: f64,
-        r_d: f64,
-    ) -> Result<Self, KinematicsError> {
+    pub fn new(ue: f64, srr: f64, lambda_rad: f64, r_b: f64, r_d: f64) -> Result<Self, KinematicsError> {
         if !ue.is_finite() {
             return Err(KinematicsError::NotFinite("Ue", ue));
         }
@@ -189,12 +182,7 @@ impl Kinematics {
     }
     /// All four surface velocities at (x, z) (m).
     pub fn at(&self, x: f64, z: f64) -> SurfaceVelocities {
-        SurfaceVelocities {
-            ub: self.u_b(x, z),
-            wb: self.w_b(x, z),
-            ud: self.u_d(x, z),
-            wd: self.w_d(x, z),
-        }
+        SurfaceVelocities { ub: self.u_b(x, z), wb: self.w_b(x, z), ud: self.u_d(x, z), wd: self.w_d(x, z) }
     }
     /// Um = (U_B + U_D)/2 (m/s).
     pub fn um(&self, x: f64, z: f64) -> f64 {
@@ -282,8 +270,7 @@ mod tests {
         let k = Kinematics::new(3.0, 0.05, 2f64.to_radians(), 0.08, 0.04).unwrap();
         let h = 1e-6;
         let (x, z) = (0.3e-3, -0.2e-3);
-        let div = (k.um(x + h, z) - k.um(x - h, z)) / (2.0 * h)
-            + (k.wm(x, z + h) - k.wm(x, z - h)) / (2.0 * h);
+        let div = (k.um(x + h, z) - k.um(x - h, z)) / (2.0 * h) + (k.wm(x, z + h) - k.wm(x, z - h)) / (2.0 * h);
         assert!(div.abs() < 1e-6);
     }
 
@@ -296,33 +283,12 @@ mod tests {
 
     #[test]
     fn rejects_bad_input() {
-        assert_eq!(
-            Kinematics::new(3.0, 0.0, 0.0, 0.08, 0.04),
-            Err(KinematicsError::ZeroTilt)
-        );
-        assert!(matches!(
-            Kinematics::new(3.0, 0.0, -0.1, 0.08, 0.04),
-            Err(KinematicsError::TiltOutOfRange(_))
-        ));
-        assert!(matches!(
-            Kinematics::new(3.0, 0.0, 2.0, 0.08, 0.04),
-            Err(KinematicsError::TiltOutOfRange(_))
-        ));
-        assert!(matches!(
-            Kinematics::new(3.0, 0.0, 0.1, 0.0, 0.04),
-            Err(KinematicsError::BadRadius("R_B", _))
-        ));
-        assert!(matches!(
-            Kinematics::new(3.0, 0.0, 0.1, 0.08, -1.0),
-            Err(KinematicsError::BadRadius("R_D", _))
-        ));
-        assert!(matches!(
-            Kinematics::new(f64::NAN, 0.0, 0.1, 0.08, 0.04),
-            Err(KinematicsError::NotFinite(..))
-        ));
-        assert!(Kinematics::new(3.0, 0.0, 0.0, 0.08, 0.04)
-            .unwrap_err()
-            .to_string()
-            .contains("singular"));
+        assert_eq!(Kinematics::new(3.0, 0.0, 0.0, 0.08, 0.04), Err(KinematicsError::ZeroTilt));
+        assert!(matches!(Kinematics::new(3.0, 0.0, -0.1, 0.08, 0.04), Err(KinematicsError::TiltOutOfRange(_))));
+        assert!(matches!(Kinematics::new(3.0, 0.0, 2.0, 0.08, 0.04), Err(KinematicsError::TiltOutOfRange(_))));
+        assert!(matches!(Kinematics::new(3.0, 0.0, 0.1, 0.0, 0.04), Err(KinematicsError::BadRadius("R_B", _))));
+        assert!(matches!(Kinematics::new(3.0, 0.0, 0.1, 0.08, -1.0), Err(KinematicsError::BadRadius("R_D", _))));
+        assert!(matches!(Kinematics::new(f64::NAN, 0.0, 0.1, 0.08, 0.04), Err(KinematicsError::NotFinite(..))));
+        assert!(Kinematics::new(3.0, 0.0, 0.0, 0.08, 0.04).unwrap_err().to_string().contains("singular"));
     }
 }

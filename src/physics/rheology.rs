@@ -86,9 +86,7 @@ impl ViscosityLaw {
             return Err(format!("Roelands law needs finite eta_R > 0 and P_R > 0 (got eta_R = {eta_r}, P_R = {p_r})"));
         }
         if s.is_nan() || s <= 0.0 {
-            return Err(format!(
-                "Roelands law needs eta_R > exp(-9.67) = 6.31e-5 Pa.s (got eta_R = {eta_r} Pa.s)"
-            ));
+            return Err(format!("Roelands law needs eta_R > exp(-9.67) = 6.31e-5 Pa.s (got eta_R = {eta_r} Pa.s)"));
         }
         let z_r = match z_r {
             Some(z) => z,
@@ -109,9 +107,7 @@ impl ViscosityLaw {
     /// Reference (ambient-pressure) viscosity eta_R (Pa.s).
     pub fn reference_viscosity(&self) -> f64 {
         match *self {
-            ViscosityLaw::Constant { eta_r }
-            | ViscosityLaw::Barus { eta_r, .. }
-            | ViscosityLaw::Roelands { eta_r, .. } => eta_r,
+            ViscosityLaw::Constant { eta_r } | ViscosityLaw::Barus { eta_r, .. } | ViscosityLaw::Roelands { eta_r, .. } => eta_r,
         }
     }
 
@@ -308,14 +304,7 @@ mod tests {
     #[test]
     fn roelands_explicit_exponent_and_errors() {
         let l = ViscosityLaw::roelands(0.012, 0.0, 1.96e8, Some(0.6)).unwrap();
-        assert_eq!(
-            l,
-            ViscosityLaw::Roelands {
-                eta_r: 0.012,
-                p_r: 1.96e8,
-                z_r: 0.6
-            }
-        );
+        assert_eq!(l, ViscosityLaw::Roelands { eta_r: 0.012, p_r: 1.96e8, z_r: 0.6 });
         assert!(ViscosityLaw::roelands(5e-5, 23e-9, 1.96e8, None).is_err());
         assert!(ViscosityLaw::roelands(0.012, 23e-9, 0.0, None).is_err());
     }
@@ -339,10 +328,7 @@ mod tests {
         let l = table1_roelands();
         assert!(rel(l.pressure_viscosity_at_ambient(), 23e-9) < 1e-12);
         // Finite-difference slope of ln eta around p = 0 equals the Barus slope alpha.
-        let barus = ViscosityLaw::Barus {
-            eta_r: 0.012,
-            alpha: 23e-9,
-        };
+        let barus = ViscosityLaw::Barus { eta_r: 0.012, alpha: 23e-9 };
         let h = 1e3;
         let s_r = fd(|p| l.viscosity(p).ln(), 0.0, h);
         let s_b = fd(|p| barus.viscosity(p).ln(), 0.0, h);
@@ -351,23 +337,13 @@ mod tests {
 
     #[test]
     fn viscosity_derivatives_match_finite_differences() {
-        let laws = [
-            table1_roelands(),
-            ViscosityLaw::Barus {
-                eta_r: 0.012,
-                alpha: 23e-9,
-            },
-            ViscosityLaw::Constant { eta_r: 0.012 },
-        ];
+        let laws = [table1_roelands(), ViscosityLaw::Barus { eta_r: 0.012, alpha: 23e-9 }, ViscosityLaw::Constant { eta_r: 0.012 }];
         for law in laws {
             for &p in &[-5e7, -1e5, 1e3, 1e7, 2e8, 8.45e8, 1.5e9] {
                 let (_, d) = law.viscosity_and_derivative(p);
                 let d_fd = fd(|q| law.viscosity(q), p, 1e-5 * p.abs().max(1e6));
                 let scale = d.abs().max(1e-30);
-                assert!(
-                    (d - d_fd).abs() / scale < 1e-6 || (d == 0.0 && d_fd == 0.0),
-                    "{law:?} p = {p}: {d} vs {d_fd}"
-                );
+                assert!((d - d_fd).abs() / scale < 1e-6 || (d == 0.0 && d_fd == 0.0), "{law:?} p = {p}: {d} vs {d_fd}");
             }
         }
     }
@@ -391,10 +367,7 @@ mod tests {
         let d = DensityLaw::DowsonHigginson { rho_r: 870.0 };
         // (5.9e8 + 1.34e9) / (5.9e8 + 1e9) = 19.3 / 15.9 = 1.213836
         let r = d.ratio_and_derivative(1e9).0;
-        assert!(
-            rel(r, 19.3 / 15.9) < 1e-14 && (r - 1.213836).abs() < 1e-6,
-            "rho/rho_R = {r}"
-        );
+        assert!(rel(r, 19.3 / 15.9) < 1e-14 && (r - 1.213836).abs() < 1e-6, "rho/rho_R = {r}");
         assert!(rel(d.density(1e9), 870.0 * 19.3 / 15.9) < 1e-14);
         // Limit 1.34 at infinite pressure, 1 at p = 0.
         assert_eq!(d.density(0.0), 870.0);

@@ -24,12 +24,7 @@ pub struct Scales {
 impl Scales {
     /// Scales of a Hertz solution.
     pub fn from_hertz(h: &Hertz) -> Self {
-        Scales {
-            a: h.a,
-            ph: h.ph,
-            r: h.radius,
-            e_prime: h.e_prime,
-        }
+        Scales { a: h.a, ph: h.ph, r: h.radius, e_prime: h.e_prime }
     }
 
     /// Film/displacement scale a^2/R (m): h = H a^2/R.
@@ -108,13 +103,7 @@ impl MoesParameters {
         let w = load / (e_prime * r * r);
         let u = eta_r * ue / (e_prime * r);
         let g = alpha * e_prime;
-        MoesParameters {
-            w,
-            u,
-            g,
-            m: w * (2.0 * u).powf(-0.75),
-            l: g * (2.0 * u).powf(0.25),
-        }
+        MoesParameters { w, u, g, m: w * (2.0 * u).powf(-0.75), l: g * (2.0 * u).powf(0.25) }
     }
 }
 
@@ -136,12 +125,7 @@ mod tests {
     fn round_trips_and_scales() {
         let s = Scales::from_hertz(&table1());
         assert!(rel(s.film_scale(), 0.92052e-3f64.powi(2) / 0.08) < 3e-4);
-        assert!(
-            rel(
-                s.x_from_dimensionless(s.x_to_dimensionless(1.23e-4)),
-                1.23e-4
-            ) < 1e-15
-        );
+        assert!(rel(s.x_from_dimensionless(s.x_to_dimensionless(1.23e-4)), 1.23e-4) < 1e-15);
         assert!(rel(s.p_from_dimensionless(s.p_to_dimensionless(3e8)), 3e8) < 1e-15);
         assert!(rel(s.h_from_dimensionless(s.h_to_dimensionless(2.5e-7)), 2.5e-7) < 1e-15);
         assert_eq!(s.x_to_dimensionless(s.a), 1.0);

@@ -55,7 +55,11 @@ fn key_numbers(s: &Value) -> Option<Key> {
 fn nan_keys(s: &Value) -> Vec<String> {
     flatten(s)
         .into_iter()
-        .filter(|(k, v)| *v == Leaf::Null && ["film.", "pressure.", "friction.", "solver."].iter().any(|p| k.starts_with(p)) && !k.contains("hamrock_dowson"))
+        .filter(|(k, v)| {
+            *v == Leaf::Null
+                && ["film.", "pressure.", "friction.", "solver."].iter().any(|p| k.starts_with(p))
+                && !k.contains("hamrock_dowson")
+        })
         .map(|(k, _)| k)
         .collect()
 }
@@ -80,7 +84,8 @@ pub fn failure_reason(log: &str, rc: Option<i32>) -> String {
 
 /// The first clause of a failure message (the path of continuation steps is in the log).
 fn short_reason(e: &str) -> String {
-    let first = e.split("; path:").next().unwrap_or(e).split("; steps:").next().unwrap_or(e).split("; last domain error").next().unwrap_or(e);
+    let first =
+        e.split("; path:").next().unwrap_or(e).split("; steps:").next().unwrap_or(e).split("; last domain error").next().unwrap_or(e);
     // Room for the reason behind a failure, e.g. the film closing next to a spin pole.
     const ROOM: usize = 260;
     if first.chars().count() > ROOM {
@@ -144,7 +149,9 @@ pub fn check_case(name: &str, default: &Run, refined: &Run) -> (String, Vec<Stri
         _ => (None, None),
     };
     let m = default.summary.as_ref().or(refined.summary.as_ref()).and_then(|s| num(s, "moes.M"));
-    let pair = |f: &dyn Fn(&Key) -> String| format!("{} / {}", keys[0].as_ref().map(f).unwrap_or("-".into()), keys[1].as_ref().map(f).unwrap_or("-".into()));
+    let pair = |f: &dyn Fn(&Key) -> String| {
+        format!("{} / {}", keys[0].as_ref().map(f).unwrap_or("-".into()), keys[1].as_ref().map(f).unwrap_or("-".into()))
+    };
     let pct = |v: Option<f64>| v.map(|v| format!("{:+.2} %", 100.0 * v)).unwrap_or("-".into());
     let worst = |f: &dyn Fn(&Key) -> f64, min: bool| {
         let v: Vec<f64> = keys.iter().flatten().map(f).collect();

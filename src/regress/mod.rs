@@ -20,7 +20,11 @@ impl std::fmt::Display for Leaf {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Leaf::Num(v) => write!(f, "{v:.10e}"),
-            Leaf::Text(s) => write!(f, "\"{}\"", if s.chars().count() > 40 { format!("{}...", s.chars().take(40).collect::<String>()) } else { s.clone() }),
+            Leaf::Text(s) => write!(
+                f,
+                "\"{}\"",
+                if s.chars().count() > 40 { format!("{}...", s.chars().take(40).collect::<String>()) } else { s.clone() }
+            ),
             Leaf::Bool(b) => write!(f, "{b}"),
             Leaf::Null => write!(f, "null"),
         }
@@ -143,7 +147,8 @@ impl Tolerances {
 }
 
 fn parse_tolerance(key: &str, v: &toml::Value) -> Result<Tolerance, String> {
-    let bad = || format!("tolerance file: '{key}' = {v}: expected a relative tolerance (number >= 0), \"ignore\" or {{ rel = .., abs = .. }}");
+    let bad =
+        || format!("tolerance file: '{key}' = {v}: expected a relative tolerance (number >= 0), \"ignore\" or {{ rel = .., abs = .. }}");
     let num = |x: &toml::Value| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)).filter(|f| *f >= 0.0);
     match v {
         toml::Value::String(s) if s == "ignore" => Ok(Tolerance::Ignore),
@@ -269,7 +274,14 @@ pub fn compare(reference: &Value, new: &Value, tol: &Tolerances) -> Comparison {
         }
         compared += 1;
         let Some(nb) = b.get(key) else {
-            rows.push(Row { key: key.clone(), reference: Some(ra.clone()), new: None, rel_change: None, tolerance: t, status: Status::Missing });
+            rows.push(Row {
+                key: key.clone(),
+                reference: Some(ra.clone()),
+                new: None,
+                rel_change: None,
+                tolerance: t,
+                status: Status::Missing,
+            });
             continue;
         };
         if ra == nb {
@@ -283,11 +295,25 @@ pub fn compare(reference: &Value, new: &Value, tol: &Tolerances) -> Comparison {
             }
             _ => (None, false),
         };
-        rows.push(Row { key: key.clone(), reference: Some(ra.clone()), new: Some(nb.clone()), rel_change, tolerance: t, status: if ok { Status::Moved } else { Status::Drift } });
+        rows.push(Row {
+            key: key.clone(),
+            reference: Some(ra.clone()),
+            new: Some(nb.clone()),
+            rel_change,
+            tolerance: t,
+            status: if ok { Status::Moved } else { Status::Drift },
+        });
     }
     for (key, nb) in &b {
         if !a.contains_key(key) && tol.for_key(key) != Tolerance::Ignore {
-            rows.push(Row { key: key.clone(), reference: None, new: Some(nb.clone()), rel_change: None, tolerance: tol.for_key(key), status: Status::Added });
+            rows.push(Row {
+                key: key.clone(),
+                reference: None,
+                new: Some(nb.clone()),
+                rel_change: None,
+                tolerance: tol.for_key(key),
+                status: Status::Added,
+            });
         }
     }
     Comparison { compared, ignored, rows }

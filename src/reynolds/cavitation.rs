@@ -21,7 +21,6 @@ pub fn penalty_law(p: f64) -> (f64, f64) {
     }
 }
 
-
 /// The lowest pressure (units of p_H) one Newton step may bring a nodal pressure to. The
 /// penalty holds a cavitated pressure at -O(1/xi) (the hard suite's deepest converged nodal
 /// pressure is -9e-4 p_H), but at a node the linearisation still treats as pressurised a

@@ -269,14 +269,7 @@ mod tests {
         // f = x^2 y / (1 + x y): df/dx = (2 x y (1 + x y) - x^2 y * y) / (1 + x y)^2
         let f = x * x * y / (1.0 + x * y);
         let q = 1.0 + a * b;
-        check(
-            f,
-            a * a * b / q,
-            [
-                (2.0 * a * b * q - a * a * b * b) / (q * q),
-                (a * a * q - a * a * b * a) / (q * q),
-            ],
-        );
+        check(f, a * a * b / q, [(2.0 * a * b * q - a * a * b * b) / (q * q), (a * a * q - a * a * b * a) / (q * q)]);
     }
 
     #[test]

@@ -41,13 +41,7 @@ fn zero_law(_: f64) -> f64 {
 impl Fluid<'static> {
     /// Incompressible, iso-viscous lubricant: eta_bar = rho_bar = 1.
     pub fn constant(lambda_bar: f64) -> Self {
-        Fluid {
-            eta: &unit_law,
-            rho: &unit_law,
-            d2eta: &zero_law,
-            d2rho: &zero_law,
-            lambda_bar,
-        }
+        Fluid { eta: &unit_law, rho: &unit_law, d2eta: &zero_law, d2rho: &zero_law, lambda_bar }
     }
 }
 
@@ -95,15 +89,7 @@ pub enum StrongResidual {
 impl Default for Stabilisation {
     /// SUPG on, delta = 1, full strong residual, Pe on |v|.
     fn default() -> Self {
-        Self {
-            supg: true,
-            delta: 1.0,
-            id: 0.0,
-            cd: 0.0,
-            penalty: 0.0,
-            residual: StrongResidual::Full,
-            film_peclet: false,
-        }
+        Self { supg: true, delta: 1.0, id: 0.0, cd: 0.0, penalty: 0.0, residual: StrongResidual::Full, film_peclet: false }
     }
 }
 
@@ -140,10 +126,7 @@ pub fn xi(pe: f64) -> (f64, f64) {
     }
     if pe < 1e-2 {
         let p2 = pe * pe;
-        (
-            pe * (1.0 / 3.0 - p2 / 45.0 + 2.0 * p2 * p2 / 945.0),
-            1.0 / 3.0 - p2 / 15.0 + 2.0 * p2 * p2 / 189.0,
-        )
+        (pe * (1.0 / 3.0 - p2 / 45.0 + 2.0 * p2 * p2 / 945.0), 1.0 / 3.0 - p2 / 15.0 + 2.0 * p2 * p2 / 189.0)
     } else {
         let s = pe.sinh(); // inf for pe > ~710: 1/s^2 = 0, fine
         (1.0 / pe.tanh() - 1.0 / pe, 1.0 / (pe * pe) - 1.0 / (s * s))
@@ -210,7 +193,15 @@ pub struct PointFields<const N: usize> {
 /// SUPG strong residual r = div(rho_bar H v) - [eps Lap P + grad eps . grad P] + pen with
 /// the terms `stab.residual` keeps (see [`StrongResidual`]); `lap_p` is Lap P (0 for P1),
 /// `pen` the interpolated penalty xi pen(P). Shared by the P2 and P1 elements.
-pub fn strong_residual<const N: usize>(stab: &Stabilisation, q: &PointFields<N>, lambda_bar: f64, lap_p: Dual<N>, v: [f64; 2], div_v: f64, pen: Dual<N>) -> Dual<N> {
+pub fn strong_residual<const N: usize>(
+    stab: &Stabilisation,
+    q: &PointFields<N>,
+    lambda_bar: f64,
+    lap_p: Dual<N>,
+    v: [f64; 2],
+    div_v: f64,
+    pen: Dual<N>,
+) -> Dual<N> {
     let (gp, gh) = (&q.grad_p, &q.grad_h);
     // div(rho H v) = v . grad(rho H) + rho H div v, grad(rho H) = rho' H grad P + rho grad H
     let drho_h = q.drho * q.h;
@@ -269,9 +260,7 @@ pub fn reynolds_element_with_source(
     }
     // div vel (zero for rigid-body entrainment; kept so the strong residual is exact
     // for any affine field): div v = sum_k v_k . grad L_k
-    let div_v: f64 = (0..3)
-        .map(|k| vel[k][0] * tri.grad_l[k][0] + vel[k][1] * tri.grad_l[k][1])
-        .sum();
+    let div_v: f64 = (0..3).map(|k| vel[k][0] * tri.grad_l[k][0] + vel[k][1] * tri.grad_l[k][1]).sum();
 
     // Nodal cavitation penalty xi pen(P_j), interpolated in the SUPG strong residual.
     let pen_nodes: [D12; 6] = std::array::from_fn(|j| {
@@ -302,10 +291,7 @@ pub fn reynolds_element_with_source(
                 gh[c] += hd[j] * dn[j][c];
             }
         }
-        let v = [
-            l[0] * vel[0][0] + l[1] * vel[1][0] + l[2] * vel[2][0],
-            l[0] * vel[0][1] + l[1] * vel[1][1] + l[2] * vel[2][1],
-        ];
+        let v = [l[0] * vel[0][0] + l[1] * vel[1][0] + l[2] * vel[2][0], l[0] * vel[0][1] + l[1] * vel[1][1] + l[2] * vel[2][1]];
         let x = tri.point(l);
         let f = source.map_or(0.0, |s| s(x[0], x[1]));
 
@@ -353,7 +339,16 @@ pub fn reynolds_element_with_source(
             for j in 0..6 {
                 pen += pen_nodes[j] * n[j];
             }
-            let fields = PointFields { h: hq, grad_p: gp, grad_h: gh, rho: rho_d, drho: drho_d, eta: eta_d, deta: pq.chain(deta, (fluid.d2eta)(pq.v)), eps };
+            let fields = PointFields {
+                h: hq,
+                grad_p: gp,
+                grad_h: gh,
+                rho: rho_d,
+                drho: drho_d,
+                eta: eta_d,
+                deta: pq.chain(deta, (fluid.d2eta)(pq.v)),
+                eps,
+            };
             let r_strong = strong_residual(stab, &fields, fluid.lambda_bar, lap_p, v, div_v, pen) - f;
 
             // tau = delta h_e / (2|v|) xi(Pe), h_e = streamline length
@@ -365,11 +360,7 @@ pub fn reynolds_element_with_source(
         }
     }
 
-    let mut out = ElementOut {
-        r: [0.0; 6],
-        dr_dp: [[0.0; 6]; 6],
-        dr_dh: [[0.0; 6]; 6],
-    };
+    let mut out = ElementOut { r: [0.0; 6], dr_dp: [[0.0; 6]; 6], dr_dh: [[0.0; 6]; 6] };
     for i in 0..6 {
         out.r[i] = res[i].v;
         out.dr_dp[i].copy_from_slice(&res[i].d[..6]);

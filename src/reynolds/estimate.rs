@@ -54,7 +54,8 @@ fn fields_at(tri: &P2Triangle, l: &[f64; 3], p: &[f64; 6], h: &[f64; 6], fluid: 
     let (rho, drho) = (fluid.rho)(pq);
     let eps = rho * hq.powi(3) / (eta * fluid.lambda_bar);
     let c = D1::constant;
-    let f = PointFields { h: c(hq), grad_p: gp.map(c), grad_h: gh.map(c), rho: c(rho), drho: c(drho), eta: c(eta), deta: c(deta), eps: c(eps) };
+    let f =
+        PointFields { h: c(hq), grad_p: gp.map(c), grad_h: gh.map(c), rho: c(rho), drho: c(drho), eta: c(eta), deta: c(deta), eps: c(eps) };
     (f, pq)
 }
 
@@ -62,7 +63,14 @@ fn fields_at(tri: &P2Triangle, l: &[f64; 3], p: &[f64; 6], h: &[f64; 6], fluid: 
 /// m12, m20), entrainment velocity `vel` at the vertices (affine inside) and cavitation
 /// penalty factor `penalty` (0: none; the nodal penalty is interpolated as in the
 /// stabilised element).
-pub fn element_residual(verts: &[[f64; 2]; 3], p: &[f64; 6], h: &[f64; 6], vel: &[[f64; 2]; 3], fluid: &Fluid, penalty: f64) -> ElementResidual {
+pub fn element_residual(
+    verts: &[[f64; 2]; 3],
+    p: &[f64; 6],
+    h: &[f64; 6],
+    vel: &[[f64; 2]; 3],
+    fluid: &Fluid,
+    penalty: f64,
+) -> ElementResidual {
     let tri = P2Triangle::new(verts);
     let mut lap_p = 0.0;
     for j in 0..6 {
@@ -88,7 +96,10 @@ pub fn element_residual(verts: &[[f64; 2]; 3], p: &[f64; 6], h: &[f64; 6], vel: 
     let mut edge_flux = [[0.0; 2]; 3];
     for (e, flux) in edge_flux.iter_mut().enumerate() {
         let (a, b) = (e, (e + 1) % 3);
-        let (d, len) = ([verts[b][0] - verts[a][0], verts[b][1] - verts[a][1]], ((verts[b][0] - verts[a][0]).powi(2) + (verts[b][1] - verts[a][1]).powi(2)).sqrt());
+        let (d, len) = (
+            [verts[b][0] - verts[a][0], verts[b][1] - verts[a][1]],
+            ((verts[b][0] - verts[a][0]).powi(2) + (verts[b][1] - verts[a][1]).powi(2)).sqrt(),
+        );
         let nrm = [orient * d[1] / len, -orient * d[0] / len];
         for (g, &(s, w)) in GAUSS2.iter().enumerate() {
             let mut l = [0.0; 3];

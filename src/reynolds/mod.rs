@@ -96,10 +96,7 @@ pub mod estimate;
 mod tests;
 
 pub use dual::Dual;
-pub use element::{
-    reynolds_element, reynolds_element_with_source, streamline_length, xi, ElementOut, Fluid,
-    Stabilisation,
-};
+pub use element::{reynolds_element, reynolds_element_with_source, streamline_length, xi, ElementOut, Fluid, Stabilisation};
 
 /// The 4 sub-triangles of a P2 triangle (local nodes v0, v1, v2, m01, m12, m20), same
 /// orientation as the parent.

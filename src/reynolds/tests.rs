@@ -30,13 +30,7 @@ fn d2rho_dh(p: f64) -> f64 {
 }
 
 fn fluid_exp_dh(lambda_bar: f64) -> Fluid<'static> {
-    Fluid {
-        eta: &eta_exp19,
-        rho: &rho_dh,
-        d2eta: &d2eta_exp19,
-        d2rho: &d2rho_dh,
-        lambda_bar,
-    }
+    Fluid { eta: &eta_exp19, rho: &rho_dh, d2eta: &d2eta_exp19, d2rho: &d2rho_dh, lambda_bar }
 }
 
 // ---------------------------------------------------------------- helpers
@@ -45,10 +39,7 @@ fn fluid_exp_dh(lambda_bar: f64) -> Fluid<'static> {
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (self.0 >> 11) as f64 / (1u64 << 53) as f64
     }
     fn range(&mut self, a: f64, b: f64) -> f64 {
@@ -63,14 +54,7 @@ fn rigid_vel(verts: &[[f64; 2]; 3], u0: f64, w0: f64, om: f64) -> [[f64; 2]; 3] 
 
 /// Central finite-difference Jacobian, compared entry by entry with the exact one.
 /// Returns the largest row-relative error max_j |J_ij - Jfd_ij| / max_j |J_ij|.
-fn fd_jacobian_error(
-    verts: &[[f64; 2]; 3],
-    p: &[f64; 6],
-    h: &[f64; 6],
-    vel: &[[f64; 2]; 3],
-    fluid: &Fluid,
-    stab: &Stabilisation,
-) -> f64 {
+fn fd_jacobian_error(verts: &[[f64; 2]; 3], p: &[f64; 6], h: &[f64; 6], vel: &[[f64; 2]; 3], fluid: &Fluid, stab: &Stabilisation) -> f64 {
     let out = reynolds_element(verts, p, h, vel, fluid, stab);
     let mut fd = [[0.0; 12]; 6];
     for j in 0..12 {
@@ -92,11 +76,7 @@ fn fd_jacobian_error(
     }
     let mut worst: f64 = 0.0;
     for i in 0..6 {
-        let exact: Vec<f64> = out.dr_dp[i]
-            .iter()
-            .chain(out.dr_dh[i].iter())
-            .copied()
-            .collect();
+        let exact: Vec<f64> = out.dr_dp[i].iter().chain(out.dr_dh[i].iter()).copied().collect();
         let scale = exact.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         assert!(scale > 0.0);
         for j in 0..12 {
@@ -118,24 +98,13 @@ fn jacobian_check(stab: Stabilisation) {
         let c = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
         let verts = [
             [c[0], c[1]],
-            [
-                c[0] + s * rng.range(0.7, 1.3),
-                c[1] + s * rng.range(-0.3, 0.3),
-            ],
-            [
-                c[0] + s * rng.range(-0.3, 0.5),
-                c[1] + s * rng.range(0.7, 1.3),
-            ],
+            [c[0] + s * rng.range(0.7, 1.3), c[1] + s * rng.range(-0.3, 0.3)],
+            [c[0] + s * rng.range(-0.3, 0.5), c[1] + s * rng.range(0.7, 1.3)],
         ];
         let p: [f64; 6] = std::array::from_fn(|_| rng.range(0.0, 0.8));
         let h: [f64; 6] = std::array::from_fn(|_| rng.range(0.3, 1.5));
         let vel = if trial % 2 == 0 {
-            rigid_vel(
-                &verts,
-                rng.range(0.2, 1.0),
-                rng.range(-0.5, 0.5),
-                rng.range(-2.0, 2.0),
-            )
+            rigid_vel(&verts, rng.range(0.2, 1.0), rng.range(-0.5, 0.5), rng.range(-2.0, 2.0))
         } else {
             // general affine field (not divergence-free): the Jacobian must still be exact
             std::array::from_fn(|_| [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)])
@@ -143,10 +112,7 @@ fn jacobian_check(stab: Stabilisation) {
         let e = fd_jacobian_error(&verts, &p, &h, &vel, &fluid, &stab);
         worst = worst.max(e);
     }
-    println!(
-        "supg = {}: worst row-relative Jacobian error vs central FD = {worst:.2e}",
-        stab.supg
-    );
+    println!("supg = {}: worst row-relative Jacobian error vs central FD = {worst:.2e}", stab.supg);
     assert!(worst < 1e-6, "Jacobian error {worst}");
 }
 
@@ -189,17 +155,11 @@ fn xi_branches_agree_and_limits() {
     // series and closed form agree at the switch, derivative matches FD
     let (a, da) = xi(1e-2 - 1e-12);
     let (b, db) = xi(1e-2 + 1e-12);
-    assert!(
-        (b - a - da * 2e-12).abs() < 1e-13 && (da - db).abs() < 1e-9,
-        "{a} {b} {da} {db}"
-    );
+    assert!((b - a - da * 2e-12).abs() < 1e-13 && (da - db).abs() < 1e-9, "{a} {b} {da} {db}");
     for pe in [1e-3, 0.05, 0.7, 3.0, 30.0] {
         let (_, d) = xi(pe);
         let fd = (xi(pe * (1.0 + 1e-6)).0 - xi(pe * (1.0 - 1e-6)).0) / (2e-6 * pe);
-        assert!(
-            (d - fd).abs() < 1e-7 * (1.0 + d.abs()),
-            "pe {pe}: {d} vs {fd}"
-        );
+        assert!((d - fd).abs() < 1e-7 * (1.0 + d.abs()), "pe {pe}: {d} vs {fd}");
     }
     assert!((xi(1e-5).0 - 1e-5 / 3.0).abs() < 1e-15);
     assert_eq!(xi(1e4).0, 1.0 - 1e-4);
@@ -220,24 +180,11 @@ fn constant_fields_give_the_couette_term_only() {
     let pc = 0.4;
     let hc = 0.7;
     let rho_h = rho_dh(pc).0 * hc;
-    let expect = [
-        -1.0 / 3.0,
-        1.0 / 6.0,
-        1.0 / 6.0,
-        -2.0 / 3.0,
-        4.0 / 3.0,
-        -2.0 / 3.0,
-    ]
-    .map(|x| -rho_h * x);
+    let expect = [-1.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0, -2.0 / 3.0, 4.0 / 3.0, -2.0 / 3.0].map(|x| -rho_h * x);
     for stab in [Stabilisation::none(), Stabilisation::supg(1.0)] {
         let out = reynolds_element(&verts, &[pc; 6], &[hc; 6], &vel, &fluid, &stab);
         for i in 0..6 {
-            assert!(
-                (out.r[i] - expect[i]).abs() < 1e-13,
-                "{stab:?} node {i}: {} vs {}",
-                out.r[i],
-                expect[i]
-            );
+            assert!((out.r[i] - expect[i]).abs() < 1e-13, "{stab:?} node {i}: {} vs {}", out.r[i], expect[i]);
         }
     }
 }
@@ -266,21 +213,10 @@ fn linear_pressure_gives_the_exact_flux() {
         gl[1].map(|x| -4.0 * x / 3.0),
     ];
     for stab in [Stabilisation::none(), Stabilisation::supg(1.0)] {
-        let out = reynolds_element(
-            &verts,
-            &p,
-            &[hc; 6],
-            &[v; 3],
-            &Fluid::constant(lambda),
-            &stab,
-        );
+        let out = reynolds_element(&verts, &p, &[hc; 6], &[v; 3], &Fluid::constant(lambda), &stab);
         for i in 0..6 {
             let e = fl[0] * int_grad[i][0] + fl[1] * int_grad[i][1];
-            assert!(
-                (out.r[i] - e).abs() < 1e-13,
-                "node {i}: {} vs {e}",
-                out.r[i]
-            );
+            assert!((out.r[i] - e).abs() < 1e-13, "node {i}: {} vs {e}", out.r[i]);
         }
     }
 }
@@ -311,29 +247,11 @@ fn square_mesh(n: usize, lo: f64, hi: f64) -> Mesh {
         for a in 0..n {
             let (i, j) = (2 * a, 2 * b);
             // (i,j) -> (i+2,j) -> (i+2,j+2) and (i,j) -> (i+2,j+2) -> (i,j+2)
-            tris.push([
-                id(i, j),
-                id(i + 2, j),
-                id(i + 2, j + 2),
-                id(i + 1, j),
-                id(i + 2, j + 1),
-                id(i + 1, j + 1),
-            ]);
-            tris.push([
-                id(i, j),
-                id(i + 2, j + 2),
-                id(i, j + 2),
-                id(i + 1, j + 1),
-                id(i + 1, j + 2),
-                id(i, j + 1),
-            ]);
+            tris.push([id(i, j), id(i + 2, j), id(i + 2, j + 2), id(i + 1, j), id(i + 2, j + 1), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 2, j + 2), id(i, j + 2), id(i + 1, j + 1), id(i + 1, j + 2), id(i, j + 1)]);
         }
     }
-    Mesh {
-        nodes,
-        tris,
-        boundary,
-    }
+    Mesh { nodes, tris, boundary }
 }
 
 struct Problem<'a> {
@@ -366,8 +284,7 @@ fn solve(pb: &Problem) -> (Vec<f64>, usize) {
             let pe: [f64; 6] = t.map(|k| p[k]);
             let he: [f64; 6] = t.map(|k| pb.h[k]);
             let ve: [[f64; 2]; 3] = std::array::from_fn(|k| (pb.vel)(verts[k][0], verts[k][1]));
-            let out =
-                reynolds_element_with_source(&verts, &pe, &he, &ve, pb.fluid, &pb.stab, pb.source);
+            let out = reynolds_element_with_source(&verts, &pe, &he, &ve, pb.fluid, &pb.stab, pb.source);
             for i in 0..6 {
                 let gi = dof[t[i]];
                 if gi == usize::MAX {
@@ -418,10 +335,7 @@ fn p_exact(x: f64, z: f64) -> f64 {
     (PI * x).sin() * (PI * z).sin()
 }
 fn grad_p_exact(x: f64, z: f64) -> [f64; 2] {
-    [
-        PI * (PI * x).cos() * (PI * z).sin(),
-        PI * (PI * x).sin() * (PI * z).cos(),
-    ]
+    [PI * (PI * x).cos() * (PI * z).sin(), PI * (PI * x).sin() * (PI * z).cos()]
 }
 fn h_exact(x: f64, z: f64) -> f64 {
     1.0 + 0.5 * (x * x + z * z)
@@ -442,9 +356,7 @@ fn mms_source(fluid: &Fluid, vel: &dyn Fn(f64, f64) -> [f64; 2], x: f64, z: f64)
     let eps = rho * h.powi(3) / (eta * fluid.lambda_bar);
     let eps_p = eps * (drho / rho - deta / eta);
     let eps_h = 3.0 * eps / h;
-    let div_flux = eps * lap_p
-        + (eps_p * gp[0] + eps_h * gh[0]) * gp[0]
-        + (eps_p * gp[1] + eps_h * gh[1]) * gp[1];
+    let div_flux = eps * lap_p + (eps_p * gp[0] + eps_h * gh[0]) * gp[0] + (eps_p * gp[1] + eps_h * gh[1]) * gp[1];
     let v = vel(x, z);
     let conv = drho * h * (v[0] * gp[0] + v[1] * gp[1]) + rho * (v[0] * gh[0] + v[1] * gh[1]);
     -div_flux + conv
@@ -457,14 +369,7 @@ fn mms_errors(fluid: &Fluid, vel: &dyn Fn(f64, f64) -> [f64; 2], stab: Stabilisa
     for n in [4, 8, 16] {
         let mesh = square_mesh(n, 0.0, 1.0);
         let h = mesh.nodes.iter().map(|x| h_exact(x[0], x[1])).collect();
-        let pb = Problem {
-            mesh: &mesh,
-            h,
-            vel,
-            fluid,
-            stab,
-            source: Some(&src),
-        };
+        let pb = Problem { mesh: &mesh, h, vel, fluid, stab, source: Some(&src) };
         let (p, its) = solve(&pb);
         let e = l2_error(&mesh, &p, &p_exact);
         println!("  n = {n:2}: L2 error {e:.3e} ({its} Newton its)");
@@ -503,13 +408,7 @@ fn manufactured_solution_converges_at_third_order_nonlinear_laws() {
     fn d2eta2(p: f64) -> f64 {
         4.0 * (2.0 * p).exp()
     }
-    let fluid = Fluid {
-        eta: &eta2,
-        rho: &rho_dh,
-        d2eta: &d2eta2,
-        d2rho: &d2rho_dh,
-        lambda_bar: 4.0,
-    };
+    let fluid = Fluid { eta: &eta2, rho: &rho_dh, d2eta: &d2eta2, d2rho: &d2rho_dh, lambda_bar: 4.0 };
     let vel = |x: f64, z: f64| [1.0 + 0.3 * z, -0.3 * x];
     for stab in [Stabilisation::none(), Stabilisation::supg(1.0)] {
         println!("nonlinear laws, {stab:?}");
@@ -577,25 +476,12 @@ fn zero(_: f64) -> f64 {
 /// Solves the boundary-layer problem (eps = 1e-6, v = (1, 0), f = 1, n = 16) and returns
 /// (min P over all nodes, max P over all nodes, P on the centre line Z = 1/2).
 fn boundary_layer(stab: Stabilisation) -> (f64, f64, Vec<f64>) {
-    let fluid = Fluid {
-        eta: &one_plus_p,
-        rho: &one_plus_p,
-        d2eta: &zero,
-        d2rho: &zero,
-        lambda_bar: 1e6,
-    };
+    let fluid = Fluid { eta: &one_plus_p, rho: &one_plus_p, d2eta: &zero, d2rho: &zero, lambda_bar: 1e6 };
     let n = 16;
     let mesh = square_mesh(n, 0.0, 1.0);
     let vel = |_: f64, _: f64| [1.0, 0.0];
     let one = |_: f64, _: f64| 1.0;
-    let pb = Problem {
-        mesh: &mesh,
-        h: vec![1.0; mesh.nodes.len()],
-        vel: &vel,
-        fluid: &fluid,
-        stab,
-        source: Some(&one),
-    };
+    let pb = Problem { mesh: &mesh, h: vec![1.0; mesh.nodes.len()], vel: &vel, fluid: &fluid, stab, source: Some(&one) };
     let (p, _) = solve(&pb);
     let m = 2 * n + 1;
     let line: Vec<f64> = (0..m).map(|i| p[n * m + i]).collect();
@@ -614,40 +500,12 @@ fn supg_removes_the_oscillations_of_an_advection_dominated_problem() {
     let dx = 1.0 / (m - 1) as f64;
     // centre-line error against the reduced solution P = X upstream of the outflow layer
     // (X <= 3/4: SUPG smears the layer over about two elements, h = 1/16)
-    let upstream = |line: &[f64]| {
-        (0..=(3 * (m - 1)) / 4)
-            .map(|i| (line[i] - i as f64 * dx).abs())
-            .fold(0.0, f64::max)
-    };
-    let wiggles = |line: &[f64]| {
-        (1..m - 1)
-            .filter(|&i| line[i] < line[i - 1] - 1e-12 && line[i + 1] > line[i] + 1e-12)
-            .count()
-    };
-    println!(
-        "Galerkin: min {lo_g:.3e} max {hi_g:.3e}, upstream error {:.3e}, local minima {}",
-        upstream(&line_g),
-        wiggles(&line_g)
-    );
-    println!(
-        "SUPG    : min {lo_s:.3e} max {hi_s:.3e}, upstream error {:.3e}, local minima {}",
-        upstream(&line_s),
-        wiggles(&line_s)
-    );
-    println!(
-        "centre line Galerkin {:?}",
-        line_g
-            .iter()
-            .map(|x| (x * 1000.0).round() / 1000.0)
-            .collect::<Vec<_>>()
-    );
-    println!(
-        "centre line SUPG     {:?}",
-        line_s
-            .iter()
-            .map(|x| (x * 1000.0).round() / 1000.0)
-            .collect::<Vec<_>>()
-    );
+    let upstream = |line: &[f64]| (0..=(3 * (m - 1)) / 4).map(|i| (line[i] - i as f64 * dx).abs()).fold(0.0, f64::max);
+    let wiggles = |line: &[f64]| (1..m - 1).filter(|&i| line[i] < line[i - 1] - 1e-12 && line[i + 1] > line[i] + 1e-12).count();
+    println!("Galerkin: min {lo_g:.3e} max {hi_g:.3e}, upstream error {:.3e}, local minima {}", upstream(&line_g), wiggles(&line_g));
+    println!("SUPG    : min {lo_s:.3e} max {hi_s:.3e}, upstream error {:.3e}, local minima {}", upstream(&line_s), wiggles(&line_s));
+    println!("centre line Galerkin {:?}", line_g.iter().map(|x| (x * 1000.0).round() / 1000.0).collect::<Vec<_>>());
+    println!("centre line SUPG     {:?}", line_s.iter().map(|x| (x * 1000.0).round() / 1000.0).collect::<Vec<_>>());
     // Galerkin oscillates with O(1) amplitude all the way upstream, and overshoots wildly
     assert!(upstream(&line_g) > 0.5 && wiggles(&line_g) > 5 && hi_g > 2.0 && lo_g < -1.0);
     // SUPG: no interior local minimum on the centre line (no oscillation), accurate

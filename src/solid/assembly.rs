@@ -34,7 +34,14 @@ pub fn assemble_stiffness(comm: ffi::MPI_Comm, mesh: &Mesh, part: &Partition, do
 
 /// Adds the element stiffness matrices of this rank's tetrahedra into `a`, with the 30
 /// global indices of each element given by `index` (-1 for constrained components).
-pub fn add_stiffness(a: &Matrix, mesh: &Mesh, part: &Partition, rank: usize, nu: f64, index: impl Fn(&[u32; 10]) -> [i32; 30]) -> Result<()> {
+pub fn add_stiffness(
+    a: &Matrix,
+    mesh: &Mesh,
+    part: &Partition,
+    rank: usize,
+    nu: f64,
+    index: impl Fn(&[u32; 10]) -> [i32; 30],
+) -> Result<()> {
     let (lambda, mu) = fem::elasticity::lame(1.0, nu);
     let mut ke = [0.0; 900];
     for (k, tet) in mesh.tets.iter().enumerate() {

@@ -216,7 +216,9 @@ fn schur_complement(mesh: &Mesh, part: &crate::mesh::Partition, dofs: &DofMap, n
     let t = std::time::Instant::now();
     let k = assemble_stiffness(selfc, mesh, part, dofs, 0, nu)?;
     let dbg = crate::ehl_options::get().monitor;
-    if dbg { eprintln!("condense: K assembled {:.2} s", t.elapsed().as_secs_f64()); }
+    if dbg {
+        eprintln!("condense: K assembled {:.2} s", t.elapsed().as_secs_f64());
+    }
     // K is symmetric positive definite (clamped base): MUMPS LDL^T without pivoting.
     pcall!(ffi::MatSetOption(k.raw(), ffi::MatOption_MAT_SPD, ffi::PetscBool_PETSC_TRUE))?;
     // Schur indices: the U_y unknowns of the face nodes (MUMPS keeps the given order).
@@ -241,7 +243,9 @@ fn schur_complement(mesh: &Mesh, part: &crate::mesh::Partition, dofs: &DofMap, n
     let mut s = OwnedMat(std::ptr::null_mut());
     let mut st: ffi::MatFactorSchurStatus = 0;
     pcall!(ffi::MatFactorCreateSchurComplement(f.0, &mut s.0, &mut st))?;
-    if dbg { eprintln!("condense: factor + Schur {:.2} s", t.elapsed().as_secs_f64()); }
+    if dbg {
+        eprintln!("condense: factor + Schur {:.2} s", t.elapsed().as_secs_f64());
+    }
     drop(f);
     drop(k);
     let mut lda: ffi::PetscInt = 0;

@@ -51,15 +51,7 @@ fn aux(r2: f64, z: f64) -> Aux {
     let phi = (1.0 / m).atan();
     let g = m * m - n * n + z * m - n;
     let h = 2.0 * m * n + m + z * n;
-    Aux {
-        a,
-        s,
-        m,
-        n,
-        phi,
-        g,
-        h,
-    }
+    Aux { a, s, m, n, phi, g, h }
 }
 
 /// Below this r^2 the axis formulas are used (the general ones divide by r^4).
@@ -72,26 +64,14 @@ pub fn hamilton_normal(x: f64, y: f64, z: f64, nu: f64) -> Stress6 {
         let (sz, sr) = huber_axis(z, nu);
         return [sr, sr, sz, 0.0, 0.0, 0.0];
     }
-    let Aux {
-        a,
-        s,
-        m,
-        n,
-        phi,
-        g,
-        h,
-    } = aux(r2, z);
+    let Aux { a, s, m, n, phi, g, h } = aux(r2, z);
     let (x2, y2) = (x * x, y * y);
-    let common =
-        (1.0 - nu) * n * z * z - (1.0 - 2.0 * nu) / 3.0 * (n * s + 2.0 * a * n + 1.0) - nu * m * z;
-    let sxx = (1.0 + nu) * z * phi
-        + ((y2 - x2) / r2 * common - n * (x2 + 2.0 * nu * y2) - m * x2 * z / s) / r2;
-    let syy = (1.0 + nu) * z * phi
-        + ((x2 - y2) / r2 * common - n * (y2 + 2.0 * nu * x2) - m * y2 * z / s) / r2;
+    let common = (1.0 - nu) * n * z * z - (1.0 - 2.0 * nu) / 3.0 * (n * s + 2.0 * a * n + 1.0) - nu * m * z;
+    let sxx = (1.0 + nu) * z * phi + ((y2 - x2) / r2 * common - n * (x2 + 2.0 * nu * y2) - m * x2 * z / s) / r2;
+    let syy = (1.0 + nu) * z * phi + ((x2 - y2) / r2 * common - n * (y2 + 2.0 * nu * x2) - m * y2 * z / s) / r2;
     let szz = -n + z * m / s;
     let r4 = r2 * r2;
-    let sxy = x * y * (1.0 - 2.0 * nu) / r4
-        * (-n * r2 + 2.0 / 3.0 * n * (s + 2.0 * a) - z * (z * n + m) + 2.0 / 3.0)
+    let sxy = x * y * (1.0 - 2.0 * nu) / r4 * (-n * r2 + 2.0 / 3.0 * n * (s + 2.0 * a) - z * (z * n + m) + 2.0 / 3.0)
         + x * y * z / r4 * (-m * r2 / s - z * n + m);
     let k = z * h / (g * g + h * h);
     let syz = -z * y * (n / s - k);
@@ -104,18 +84,9 @@ pub fn hamilton_tangential(x: f64, y: f64, z: f64, nu: f64) -> Stress6 {
     let r2 = x * x + y * y;
     if r2 < AXIS_R2 {
         let at = if z > 0.0 { z * (1.0 / z).atan() } else { 0.0 };
-        return [
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            -1.0 + 1.5 * at - z * z / (2.0 * (1.0 + z * z)),
-        ];
+        return [0.0, 0.0, 0.0, 0.0, 0.0, -1.0 + 1.5 * at - z * z / (2.0 * (1.0 + z * z))];
     }
-    let Aux {
-        a, s, m, n, phi, ..
-    } = aux(r2, z);
+    let Aux { a, s, m, n, phi, .. } = aux(r2, z);
     let (x2, y2, z2) = (x * x, y * y, z * z);
     let r4 = r2 * r2;
     let c = 1.0 - 2.0 * nu;
@@ -123,39 +94,21 @@ pub fn hamilton_tangential(x: f64, y: f64, z: f64, nu: f64) -> Stress6 {
     let gx = 0.5 - 2.0 * x2 / r2;
     let gy = 0.5 - 2.0 * y2 / r2;
     let sxx = -x * (nu / 4.0 + 1.0) * phi
-        + x * m / r4
-            * (fx * (s * nu - 2.0 * a * nu + z2) + x2 * z2 / s + 7.0 * nu * r2 / 4.0
-                - 2.0 * nu * x2
-                + r2)
-        + x * z * n / r4
-            * (fx * (-s / 6.0 * c - a / 3.0 * c - 0.5 * (z2 + 3.0)) + x2 / s
-                - nu * r2 / 4.0
-                - 7.0 * r2 / 4.0)
+        + x * m / r4 * (fx * (s * nu - 2.0 * a * nu + z2) + x2 * z2 / s + 7.0 * nu * r2 / 4.0 - 2.0 * nu * x2 + r2)
+        + x * z * n / r4 * (fx * (-s / 6.0 * c - a / 3.0 * c - 0.5 * (z2 + 3.0)) + x2 / s - nu * r2 / 4.0 - 7.0 * r2 / 4.0)
         + 4.0 * x * z / (3.0 * r4) * fx * c;
     let syy = -0.75 * nu * x * phi
         + x * m / r4 * (gy * (nu * (s - 2.0 * a + r2) + z2) + y2 * z2 / s + 0.75 * nu * r2)
-        + z * x * n / r4
-            * (gy * (-s / 6.0 * c - a / 3.0 * c - 0.5 * z2 - 1.5) + y2 / s
-                - 0.75 * nu * r2
-                - 0.25 * r2)
+        + z * x * n / r4 * (gy * (-s / 6.0 * c - a / 3.0 * c - 0.5 * z2 - 1.5) + y2 / s - 0.75 * nu * r2 - 0.25 * r2)
         + 4.0 / 3.0 * z * x / r4 * gy * c;
     let szz = z * x * n / (2.0 * r2) * (1.0 - (r2 + z2 + 1.0) / s);
     let sxy = 0.5 * y * (0.5 * nu - 1.0) * phi
-        + y * m / r4
-            * (x2 * z2 / s + nu * ((s - 2.0 * a) * gx - 2.0 * x2 + 0.25 * r2) + 0.5 * r2 + z2 * gx)
-        + y * z * n / r4
-            * (gx * (-c * (s / 6.0 + a / 3.0) - 0.5 * z2 - 1.5 - 0.5 * r2)
-                + 0.25 * nu * r2
-                + x2 / s
-                - 0.5 * y2
-                - 1.5 * x2)
+        + y * m / r4 * (x2 * z2 / s + nu * ((s - 2.0 * a) * gx - 2.0 * x2 + 0.25 * r2) + 0.5 * r2 + z2 * gx)
+        + y * z * n / r4 * (gx * (-c * (s / 6.0 + a / 3.0) - 0.5 * z2 - 1.5 - 0.5 * r2) + 0.25 * nu * r2 + x2 / s - 0.5 * y2 - 1.5 * x2)
         + 4.0 * y * z / (3.0 * r4) * gx * c;
-    let syz = x * y * z / (2.0 * r4)
-        * (m * (0.5 + (0.5 * z2 - 1.5 - 0.5 * r2) / s)
-            + 0.5 * z * n * (-3.0 + (5.0 + z2 + r2) / s));
-    let sxz = 1.5 * z * phi
-        + z * m / r2 * (1.0 + x2 / r2 - x2 / s)
-        + n / r2 * (-0.75 * (s + 2.0 * a) + z2 - 0.75 - 0.25 * r2 + 0.5 * z2 * gx);
+    let syz = x * y * z / (2.0 * r4) * (m * (0.5 + (0.5 * z2 - 1.5 - 0.5 * r2) / s) + 0.5 * z * n * (-3.0 + (5.0 + z2 + r2) / s));
+    let sxz =
+        1.5 * z * phi + z * m / r2 * (1.0 + x2 / r2 - x2 / s) + n / r2 * (-0.75 * (s + 2.0 * a) + z2 - 0.75 - 0.25 * r2 + 0.5 * z2 * gx);
     [sxx, syy, szz, sxy, syz, sxz]
 }
 
@@ -180,10 +133,7 @@ pub fn sliding_von_mises_max(nu: f64, mu: f64) -> (f64, f64, f64) {
     let f = |x: f64, z: f64| von_mises(&hamilton_sliding(x, 0.0, z.max(0.0), nu, mu));
     let mut best = (f64::NEG_INFINITY, 0.0, 0.0);
     let scan = |x0: f64, x1: f64, z0: f64, z1: f64, h: f64, best: &mut (f64, f64, f64)| {
-        let (nx, nz) = (
-            ((x1 - x0) / h).round() as i64,
-            ((z1 - z0) / h).round() as i64,
-        );
+        let (nx, nz) = (((x1 - x0) / h).round() as i64, ((z1 - z0) / h).round() as i64);
         for i in 0..=nx {
             for j in 0..=nz {
                 let (x, z) = (x0 + i as f64 * h, (z0 + j as f64 * h).max(0.0));
@@ -197,14 +147,7 @@ pub fn sliding_von_mises_max(nu: f64, mu: f64) -> (f64, f64, f64) {
     scan(-1.5, 1.5, 0.0, 1.5, 0.01, &mut best);
     for h in [0.001, 0.0001] {
         let (x, z) = (best.1, best.2);
-        scan(
-            x - 15.0 * h,
-            x + 15.0 * h,
-            z - 15.0 * h,
-            z + 15.0 * h,
-            h,
-            &mut best,
-        );
+        scan(x - 15.0 * h, x + 15.0 * h, z - 15.0 * h, z + 15.0 * h, h, &mut best);
     }
     best
 }
@@ -233,15 +176,7 @@ mod tests {
 
     /// Interior points away from the axis and from the contact edge's surface singularity.
     fn points() -> Vec<[f64; 3]> {
-        vec![
-            [0.3, 0.2, 0.5],
-            [-0.7, 0.4, 0.3],
-            [1.2, -0.5, 0.8],
-            [0.1, -0.9, 1.4],
-            [-1.5, -1.1, 0.6],
-            [0.5, 0.05, 0.25],
-            [2.5, 1.0, 2.0],
-        ]
+        vec![[0.3, 0.2, 0.5], [-0.7, 0.4, 0.3], [1.2, -0.5, 0.8], [0.1, -0.9, 1.4], [-1.5, -1.1, 0.6], [0.5, 0.05, 0.25], [2.5, 1.0, 2.0]]
     }
 
     /// div sigma = 0 and the Beltrami-Michell equations
@@ -250,11 +185,7 @@ mod tests {
         for p in points() {
             let h = 1e-4;
             for i in 0..3 {
-                let div: f64 = (0..3)
-                    .map(|j| {
-                        (at(f, shifted(p, j, h))[i][j] - at(f, shifted(p, j, -h))[i][j]) / (2.0 * h)
-                    })
-                    .sum();
+                let div: f64 = (0..3).map(|j| (at(f, shifted(p, j, h))[i][j] - at(f, shifted(p, j, -h))[i][j]) / (2.0 * h)).sum();
                 assert!(div.abs() < 1e-6, "div sigma[{i}] = {div} at {p:?}");
             }
             let h = 2e-3;
@@ -265,13 +196,8 @@ mod tests {
             let s0 = at(f, p);
             for i in 0..3 {
                 for j in 0..3 {
-                    let lap: f64 = (0..3)
-                        .map(|d| {
-                            (at(f, shifted(p, d, h))[i][j] - 2.0 * s0[i][j]
-                                + at(f, shifted(p, d, -h))[i][j])
-                                / (h * h)
-                        })
-                        .sum();
+                    let lap: f64 =
+                        (0..3).map(|d| (at(f, shifted(p, d, h))[i][j] - 2.0 * s0[i][j] + at(f, shifted(p, d, -h))[i][j]) / (h * h)).sum();
                     let didj = if i == j {
                         (tr(shifted(p, i, h)) - 2.0 * tr(p) + tr(shifted(p, i, -h))) / (h * h)
                     } else {
@@ -282,10 +208,7 @@ mod tests {
                         (tr(pp) - tr(pm) - tr(mp) + tr(mm)) / (4.0 * h * h)
                     };
                     let bm = lap + didj / (1.0 + NU);
-                    assert!(
-                        bm.abs() < 2e-4,
-                        "Beltrami-Michell ({i},{j}) = {bm} at {p:?}"
-                    );
+                    assert!(bm.abs() < 2e-4, "Beltrami-Michell ({i},{j}) = {bm} at {p:?}");
                 }
             }
         }
@@ -305,37 +228,15 @@ mod tests {
     #[test]
     fn surface_tractions() {
         let z = 1e-9;
-        for (x, y) in [
-            (0.2, 0.3),
-            (-0.5, 0.1),
-            (0.7, -0.6),
-            (1.3, 0.2),
-            (-0.4, 1.5),
-        ] {
+        for (x, y) in [(0.2, 0.3), (-0.5, 0.1), (0.7, -0.6), (1.3, 0.2), (-0.4, 1.5)] {
             let r2: f64 = x * x + y * y;
             let p = if r2 < 1.0 { (1.0 - r2).sqrt() } else { 0.0 };
             let n = hamilton_normal(x, y, z, NU);
-            assert!(
-                (n[2] + p).abs() < 1e-6,
-                "normal: sigma_zz = {} at ({x}, {y}), p = {p}",
-                n[2]
-            );
-            assert!(
-                n[4].abs() < 1e-6 && n[5].abs() < 1e-6,
-                "normal: shear traction {:?}",
-                n
-            );
+            assert!((n[2] + p).abs() < 1e-6, "normal: sigma_zz = {} at ({x}, {y}), p = {p}", n[2]);
+            assert!(n[4].abs() < 1e-6 && n[5].abs() < 1e-6, "normal: shear traction {:?}", n);
             let t = hamilton_tangential(x, y, z, NU);
-            assert!(
-                (t[5] + p).abs() < 1e-6,
-                "tangential: sigma_xz = {} at ({x}, {y}), q = {p}",
-                t[5]
-            );
-            assert!(
-                t[4].abs() < 1e-6 && t[2].abs() < 1e-6,
-                "tangential: {:?}",
-                t
-            );
+            assert!((t[5] + p).abs() < 1e-6, "tangential: sigma_xz = {} at ({x}, {y}), q = {p}", t[5]);
+            assert!(t[4].abs() < 1e-6 && t[2].abs() < 1e-6, "tangential: {:?}", t);
         }
     }
 
@@ -349,18 +250,10 @@ mod tests {
         for z in [0.2, 0.48, 1.0, 2.5] {
             let (sz, sr) = huber_axis(z, NU);
             let g = hamilton_normal(1e-3, 0.0, z, NU);
-            assert!(
-                (g[2] - sz).abs() < 1e-5 && (g[0] - sr).abs() < 1e-4 && (g[1] - sr).abs() < 1e-4,
-                "z = {z}: {g:?} vs ({sz}, {sr})"
-            );
+            assert!((g[2] - sz).abs() < 1e-5 && (g[0] - sr).abs() < 1e-4 && (g[1] - sr).abs() < 1e-4, "z = {z}: {g:?} vs ({sz}, {sr})");
             let t = hamilton_tangential(1e-3, 0.0, z, NU);
             let t0 = hamilton_tangential(0.0, 0.0, z, NU);
-            assert!(
-                (t[5] - t0[5]).abs() < 1e-4,
-                "z = {z}: {} vs {}",
-                t[5],
-                t0[5]
-            );
+            assert!((t[5] - t0[5]).abs() < 1e-4, "z = {z}: {} vs {}", t[5], t0[5]);
         }
     }
 
@@ -370,30 +263,18 @@ mod tests {
         // largest shear stress (0.3100 p0 at 0.481 a).
         let (v, x, z) = sliding_von_mises_max(NU, 0.0);
         let (sz, sr) = huber_axis(z, NU);
-        assert!(
-            x.abs() < 1e-3 && (v - (sr - sz).abs()).abs() < 1e-6,
-            "{v} at ({x}, {z})"
-        );
-        assert!(
-            (v - 0.62).abs() < 0.001 && (z - 0.481).abs() < 0.002,
-            "{v} at z = {z}"
-        );
+        assert!(x.abs() < 1e-3 && (v - (sr - sz).abs()).abs() < 1e-6, "{v} at ({x}, {z})");
+        assert!((v - 0.62).abs() < 0.001 && (z - 0.481).abs() < 0.002, "{v} at z = {z}");
         // Friction pulls the maximum forward and up, and above mu ~ 0.3 it jumps to the
         // trailing edge of the surface (tension and traction add up there).
         let mut last = (v, x, z);
         for mu in [0.1, 0.2, 0.3] {
             let m = sliding_von_mises_max(NU, mu);
-            assert!(
-                m.0 > last.0 && m.1 > last.1 && m.2 < last.2 && m.2 > 0.3,
-                "mu = {mu}: {m:?}"
-            );
+            assert!(m.0 > last.0 && m.1 > last.1 && m.2 < last.2 && m.2 > 0.3, "mu = {mu}: {m:?}");
             last = m;
         }
         let (_, x, z) = sliding_von_mises_max(NU, 0.4);
-        assert!(
-            z == 0.0 && (x + 1.0).abs() < 0.01,
-            "mu = 0.4: maximum at ({x}, {z})"
-        );
+        assert!(z == 0.0 && (x + 1.0).abs() < 0.01, "mu = 0.4: maximum at ({x}, {z})");
     }
 
     /// Johnson: the largest shear stress on the axis is 0.31 p0 at z = 0.48 a (nu = 0.3).

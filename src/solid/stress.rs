@@ -19,13 +19,7 @@ pub type Sym = [f64; 6];
 /// The Cauchy stress of the P2 displacement `u` (30 node-major values) of the tetrahedron
 /// `verts` at the point with barycentric coordinates `bary`, for Lamé parameters
 /// `(lambda, mu)`.
-pub fn element_stress(
-    verts: &[[f64; 3]; 4],
-    u: &[f64; 30],
-    bary: [f64; 4],
-    lambda: f64,
-    mu: f64,
-) -> Sym {
+pub fn element_stress(verts: &[[f64; 3]; 4], u: &[f64; 30], bary: [f64; 4], lambda: f64, mu: f64) -> Sym {
     let geo = AffineTet::new(verts);
     let d = p2_tet_grads_bary(bary, &geo.grad_bary);
     let mut g = [[0.0; 3]; 3];
@@ -146,8 +140,7 @@ pub fn recover_spr(
         }
     }
     // Sampled stresses of every tetrahedron a fit needs (computed once).
-    let mut samples: std::collections::HashMap<u32, [([f64; 3], Sym); 4]> =
-        std::collections::HashMap::new();
+    let mut samples: std::collections::HashMap<u32, [([f64; 3], Sym); 4]> = std::collections::HashMap::new();
     let mut evaluated = 0;
     let mut sample = |t: u32| -> [([f64; 3], Sym); 4] {
         *samples.entry(t).or_insert_with(|| {
@@ -165,14 +158,7 @@ pub fn recover_spr(
     let basis = |d: [f64; 3], quadratic: bool| -> Vec<f64> {
         let mut b = vec![1.0, d[0], d[1], d[2]];
         if quadratic {
-            b.extend([
-                d[0] * d[0],
-                d[1] * d[1],
-                d[2] * d[2],
-                d[0] * d[1],
-                d[1] * d[2],
-                d[0] * d[2],
-            ]);
+            b.extend([d[0] * d[0], d[1] * d[1], d[2] * d[2], d[0] * d[1], d[1] * d[2], d[0] * d[2]]);
         }
         b
     };
@@ -184,10 +170,7 @@ pub fn recover_spr(
         let patch = &inc[start[v]..start[v + 1]];
         let pts: Vec<([f64; 3], Sym)> = patch.iter().flat_map(|&t| sample(t)).collect();
         let c = nodes[v];
-        let scale = pts
-            .iter()
-            .map(|(x, _)| (0..3).map(|k| (x[k] - c[k]).abs()).fold(0.0, f64::max))
-            .fold(1e-300, f64::max);
+        let scale = pts.iter().map(|(x, _)| (0..3).map(|k| (x[k] - c[k]).abs()).fold(0.0, f64::max)).fold(1e-300, f64::max);
         // Quadratic when the patch determines it (well conditioned), linear otherwise (a
         // patch on the boundary may leave a quadratic vanishing at every sample).
         let mut fitted = None;
@@ -211,19 +194,12 @@ pub fn recover_spr(
             }
             let svd = ata.svd(true, true);
             let smax = svd.singular_values.iter().fold(0.0f64, |a, &b| a.max(b));
-            let smin = svd
-                .singular_values
-                .iter()
-                .fold(f64::INFINITY, |a, &b| a.min(b));
+            let smin = svd.singular_values.iter().fold(f64::INFINITY, |a, &b| a.min(b));
             if smin < 1e-8 * smax {
                 continue;
             }
             if let Ok(coef) = svd.solve(&atb, 0.0) {
-                fitted = Some(
-                    (0..nb)
-                        .map(|i| std::array::from_fn(|k| coef[(i, k)]))
-                        .collect::<Vec<[f64; 6]>>(),
-                );
+                fitted = Some((0..nb).map(|i| std::array::from_fn(|k| coef[(i, k)])).collect::<Vec<[f64; 6]>>());
                 break;
             }
         }
@@ -232,10 +208,7 @@ pub fn recover_spr(
     }
     let eval = |f: &Fit, x: [f64; 3]| -> Sym {
         let (c, scale, coefs) = f;
-        let b = basis(
-            std::array::from_fn(|k| (x[k] - c[k]) / scale),
-            coefs.len() == 10,
-        );
+        let b = basis(std::array::from_fn(|k| (x[k] - c[k]) / scale), coefs.len() == 10);
         std::array::from_fn(|k| (0..coefs.len()).map(|i| b[i] * coefs[i][k]).sum())
     };
     let mut out = vec![[0.0; 6]; n_nodes];
@@ -249,20 +222,12 @@ pub fn recover_spr(
             if !wanted[n] || done[n] {
                 continue;
             }
-            let ends: Vec<usize> = if k < 4 {
-                vec![n]
-            } else {
-                TET_EDGES[k - 4].iter().map(|&i| tet[i] as usize).collect()
-            };
-            let vals: Vec<Sym> = ends
-                .iter()
-                .filter_map(|&v| fits[v].as_ref().map(|f| eval(f, nodes[n])))
-                .collect();
+            let ends: Vec<usize> = if k < 4 { vec![n] } else { TET_EDGES[k - 4].iter().map(|&i| tet[i] as usize).collect() };
+            let vals: Vec<Sym> = ends.iter().filter_map(|&v| fits[v].as_ref().map(|f| eval(f, nodes[n]))).collect();
             if vals.is_empty() {
                 continue;
             }
-            out[n] =
-                std::array::from_fn(|c| vals.iter().map(|s| s[c]).sum::<f64>() / vals.len() as f64);
+            out[n] = std::array::from_fn(|c| vals.iter().map(|s| s[c]).sum::<f64>() / vals.len() as f64);
             done[n] = true;
         }
     }
@@ -299,8 +264,7 @@ pub fn principal(s: &Sym) -> [f64; 3] {
     }
     let p = (p2 / 6.0).sqrt();
     // det((S - q I)/p) / 2, clamped to [-1, 1] against round-off.
-    let det = a * (b * c - s[4] * s[4]) - s[3] * (s[3] * c - s[4] * s[5])
-        + s[5] * (s[3] * s[4] - b * s[5]);
+    let det = a * (b * c - s[4] * s[4]) - s[3] * (s[3] * c - s[4] * s[5]) + s[5] * (s[3] * s[4] - b * s[5]);
     let r = (det / (2.0 * p * p * p)).clamp(-1.0, 1.0);
     let phi = r.acos() / 3.0;
     let e1 = q + 2.0 * p * phi.cos();
@@ -323,12 +287,7 @@ mod tests {
     use nalgebra::Matrix3;
 
     fn verts() -> [[f64; 3]; 4] {
-        [
-            [0.1, -0.2, 0.3],
-            [1.3, 0.1, 0.2],
-            [0.2, 0.9, -0.1],
-            [0.4, 0.3, 1.1],
-        ]
+        [[0.1, -0.2, 0.3], [1.3, 0.1, 0.2], [0.2, 0.9, -0.1], [0.4, 0.3, 1.1]]
     }
 
     /// u_c = sum_d A[c][d] x_d + quadratic part (gradient given analytically).
@@ -338,11 +297,7 @@ mod tests {
             0.1 * x[0] + 0.4 * x[1] - 0.7 * x[2] - 0.3 * x[2] * x[2],
             0.6 * x[0] + 0.2 * x[1] - 0.1 * x[2] + 0.2 * x[0] * x[0],
         ];
-        let g = [
-            [0.3 + 0.7 * x[1], -0.2 + 0.7 * x[0], 0.5],
-            [0.1, 0.4, -0.7 - 0.6 * x[2]],
-            [0.6 + 0.4 * x[0], 0.2, -0.1],
-        ];
+        let g = [[0.3 + 0.7 * x[1], -0.2 + 0.7 * x[0], 0.5], [0.1, 0.4, -0.7 - 0.6 * x[2]], [0.6 + 0.4 * x[0], 0.2, -0.1]];
         (u, g)
     }
 
@@ -366,12 +321,7 @@ mod tests {
             let e = element_stress(&v, &u, bary, l, m);
             let want = [s[0][0], s[1][1], s[2][2], s[0][1], s[1][2], s[0][2]];
             for c in 0..6 {
-                assert!(
-                    (e[c] - want[c]).abs() < 1e-12,
-                    "component {c}: {} vs {}",
-                    e[c],
-                    want[c]
-                );
+                assert!((e[c] - want[c]).abs() < 1e-12, "component {c}: {} vs {}", e[c], want[c]);
             }
         }
     }
@@ -396,10 +346,7 @@ mod tests {
         assert_eq!(count, tets.len());
         for (n, x) in nodes.iter().enumerate() {
             let e = stress_from_grad(&field(*x).1, l, m);
-            assert!(
-                (s[n][0] - e[0][0]).abs() < 1e-12 && (s[n][4] - e[1][2]).abs() < 1e-12,
-                "node {n}"
-            );
+            assert!((s[n][0] - e[0][0]).abs() < 1e-12 && (s[n][4] - e[1][2]).abs() < 1e-12, "node {n}");
         }
         let t = 5;
         let nodal: [Sym; 10] = tets[t].map(|n| s[n as usize]);
@@ -410,40 +357,18 @@ mod tests {
         let r = eval_p2(&nodal, b);
         assert!((r[2] - e[2][2]).abs() < 1e-12 && (r[5] - e[0][2]).abs() < 1e-12);
         // The patch recovery reproduces a linear field too (a polynomial of its basis).
-        let (s, _) = recover_spr(
-            &nodes,
-            vertex_count(&tets),
-            &tets,
-            &verts,
-            &u,
-            &wanted,
-            l,
-            m,
-        );
+        let (s, _) = recover_spr(&nodes, vertex_count(&tets), &tets, &verts, &u, &wanted, l, m);
         for (n, x) in nodes.iter().enumerate() {
             let e = stress_from_grad(&field(*x).1, l, m);
-            assert!(
-                (s[n][0] - e[0][0]).abs() < 1e-10 && (s[n][4] - e[1][2]).abs() < 1e-10,
-                "SPR node {n}: {:?}",
-                s[n]
-            );
+            assert!((s[n][0] - e[0][0]).abs() < 1e-10 && (s[n][4] - e[1][2]).abs() < 1e-10, "SPR node {n}: {:?}", s[n]);
         }
     }
 
     /// kuhn_box_mesh numbers the vertices first? Count the nodes that are tet corners and
     /// check they are the first ones.
     fn vertex_count(tets: &[[u32; 10]]) -> usize {
-        let nv = tets
-            .iter()
-            .flat_map(|t| t[..4].iter())
-            .map(|&v| v as usize + 1)
-            .max()
-            .unwrap();
-        assert!(
-            tets.iter()
-                .all(|t| t[4..].iter().all(|&m| m as usize >= nv)),
-            "vertices first"
-        );
+        let nv = tets.iter().flat_map(|t| t[..4].iter()).map(|&v| v as usize + 1).max().unwrap();
+        assert!(tets.iter().all(|t| t[4..].iter().all(|&m| m as usize >= nv)), "vertices first");
         nv
     }
 
@@ -464,9 +389,7 @@ mod tests {
                 assert!((p[k] - ev[k]).abs() < 1e-7, "{s:?}: {p:?} vs {ev:?}");
             }
             assert!((tresca(&s) - (ev[0] - ev[2])).abs() < 1e-7);
-            let vm = (0.5
-                * ((ev[0] - ev[1]).powi(2) + (ev[1] - ev[2]).powi(2) + (ev[2] - ev[0]).powi(2)))
-            .sqrt();
+            let vm = (0.5 * ((ev[0] - ev[1]).powi(2) + (ev[1] - ev[2]).powi(2) + (ev[2] - ev[0]).powi(2))).sqrt();
             assert!((von_mises(&s) - vm).abs() < 1e-12);
         }
         // Pure shear tau: von Mises sqrt(3) tau, Tresca 2 tau.

@@ -146,55 +146,13 @@ pub const EFFECTS_FIELDS: &[Field] = &[
         Kind::Choice(LubricationModel::NAMES),
         Presence::Default("\"reynolds\"")
     ),
-    f!(
-        "elasticity",
-        "deformation of the solids",
-        "",
-        Kind::Choice(ElasticityModel::NAMES),
-        Presence::Default("\"elastic\"")
-    ),
-    f!(
-        "viscosity",
-        "pressure-viscosity law",
-        "",
-        Kind::Choice(ViscosityModel::NAMES),
-        Presence::Default("\"roelands\"")
-    ),
-    f!(
-        "density",
-        "pressure-density law",
-        "",
-        Kind::Choice(DensityModel::NAMES),
-        Presence::Default("\"dowson-higginson\"")
-    ),
-    f!(
-        "kinematics",
-        "surface velocities (spin or uniform)",
-        "",
-        Kind::Choice(KinematicsModel::NAMES),
-        Presence::Default("\"spin\"")
-    ),
-    f!(
-        "friction",
-        "shear-stress model of the friction pass",
-        "",
-        Kind::Choice(FrictionModel::NAMES),
-        Presence::Default("\"ree-eyring\"")
-    ),
-    f!(
-        "cavitation",
-        "cavitation model",
-        "",
-        Kind::Choice(CavitationModel::NAMES),
-        Presence::Default("\"penalty\"")
-    ),
-    f!(
-        "symmetry",
-        "use of a symmetry plane",
-        "",
-        Kind::Choice(SymmetryMode::NAMES),
-        Presence::Default("\"auto\"")
-    ),
+    f!("elasticity", "deformation of the solids", "", Kind::Choice(ElasticityModel::NAMES), Presence::Default("\"elastic\"")),
+    f!("viscosity", "pressure-viscosity law", "", Kind::Choice(ViscosityModel::NAMES), Presence::Default("\"roelands\"")),
+    f!("density", "pressure-density law", "", Kind::Choice(DensityModel::NAMES), Presence::Default("\"dowson-higginson\"")),
+    f!("kinematics", "surface velocities (spin or uniform)", "", Kind::Choice(KinematicsModel::NAMES), Presence::Default("\"spin\"")),
+    f!("friction", "shear-stress model of the friction pass", "", Kind::Choice(FrictionModel::NAMES), Presence::Default("\"ree-eyring\"")),
+    f!("cavitation", "cavitation model", "", Kind::Choice(CavitationModel::NAMES), Presence::Default("\"penalty\"")),
+    f!("symmetry", "use of a symmetry plane", "", Kind::Choice(SymmetryMode::NAMES), Presence::Default("\"auto\"")),
     f!(
         "surface_traction",
         "tangential traction of the subsurface stress field (output.subsurface)",
@@ -203,4 +161,3 @@ pub const EFFECTS_FIELDS: &[Field] = &[
         Presence::Default("\"none\"")
     ),
 ];
-

@@ -15,24 +15,10 @@ use super::spec::{Field, Kind, Presence, Range};
 /// Builds a [`Field`] in a const context.
 macro_rules! f {
     ($key:literal, $what:literal, $unit:literal, $kind:expr, $presence:expr) => {
-        Field {
-            key: $key,
-            what: $what,
-            unit: $unit,
-            kind: $kind,
-            presence: $presence,
-            note: "",
-        }
+        Field { key: $key, what: $what, unit: $unit, kind: $kind, presence: $presence, note: "" }
     };
     ($key:literal, $what:literal, $unit:literal, $kind:expr, $presence:expr, note = $note:literal) => {
-        Field {
-            key: $key,
-            what: $what,
-            unit: $unit,
-            kind: $kind,
-            presence: $presence,
-            note: $note,
-        }
+        Field { key: $key, what: $what, unit: $unit, kind: $kind, presence: $presence, note: $note }
     };
 }
 
@@ -274,7 +260,6 @@ pub const ACCURACY_FIELDS: &[Field] = &[
     ),
 ];
 
-
 // ---------------------------------------------------------------------------------------
 // [geometry]
 
@@ -299,20 +284,8 @@ pub struct Geometry {
 
 /// Keys of `[geometry]`.
 pub const GEOMETRY_FIELDS: &[Field] = &[
-    f!(
-        "ball_radius",
-        "ball radius R_B",
-        "m",
-        Kind::Number(Range::Positive),
-        Presence::Required
-    ),
-    f!(
-        "disc_track_radius",
-        "radius of the contact track on the disc R_D",
-        "m",
-        Kind::Number(Range::Positive),
-        Presence::Default("0.04")
-    ),
+    f!("ball_radius", "ball radius R_B", "m", Kind::Number(Range::Positive), Presence::Required),
+    f!("disc_track_radius", "radius of the contact track on the disc R_D", "m", Kind::Number(Range::Positive), Presence::Default("0.04")),
 ];
 
 // ---------------------------------------------------------------------------------------
@@ -330,20 +303,8 @@ pub struct Materials {
 
 /// Keys of `[materials]`.
 pub const MATERIALS_FIELDS: &[Field] = &[
-    f!(
-        "ball",
-        "elastic material of the ball B",
-        "",
-        Kind::Table(MATERIAL_FIELDS),
-        Presence::Required
-    ),
-    f!(
-        "disc",
-        "elastic material of the disc D",
-        "",
-        Kind::Table(MATERIAL_FIELDS),
-        Presence::Required
-    ),
+    f!("ball", "elastic material of the ball B", "", Kind::Table(MATERIAL_FIELDS), Presence::Required),
+    f!("disc", "elastic material of the disc D", "", Kind::Table(MATERIAL_FIELDS), Presence::Required),
 ];
 
 /// `[materials.ball]` / `[materials.disc]`: an isotropic linear elastic material.
@@ -358,28 +319,15 @@ pub struct ElasticMaterial {
 
 /// Keys of `[materials.ball]` and `[materials.disc]`.
 pub const MATERIAL_FIELDS: &[Field] = &[
-    f!(
-        "young_modulus",
-        "Young's modulus E",
-        "Pa",
-        Kind::Number(Range::Positive),
-        Presence::Required
-    ),
-    f!(
-        "poisson_ratio",
-        "Poisson's ratio nu",
-        "",
-        Kind::Number(Range::Open(-1.0, 0.5)),
-        Presence::Required
-    ),
+    f!("young_modulus", "Young's modulus E", "Pa", Kind::Number(Range::Positive), Presence::Required),
+    f!("poisson_ratio", "Poisson's ratio nu", "", Kind::Number(Range::Open(-1.0, 0.5)), Presence::Required),
 ];
 
 // ---------------------------------------------------------------------------------------
 // [lubricant]
 
 /// Default Roelands reference pressure P_R (Pa).
-pub const DEFAULT_ROELANDS_REFERENCE_PRESSURE: f64 =
-    crate::physics::rheology::ROELANDS_REFERENCE_PRESSURE;
+pub const DEFAULT_ROELANDS_REFERENCE_PRESSURE: f64 = crate::physics::rheology::ROELANDS_REFERENCE_PRESSURE;
 /// Default reference density rho_R (kg/m^3).
 pub const DEFAULT_DENSITY: f64 = 870.0;
 /// Default Ree-Eyring stress tau0 (Pa) (paper Table 1).
@@ -425,12 +373,22 @@ pub struct Lubricant {
 /// Keys of `[lubricant]`.
 pub const LUBRICANT_FIELDS: &[Field] = &[
     f!("viscosity", "reference viscosity eta_R", "Pa.s", Kind::Number(Range::Positive), Presence::Required),
-    f!("pressure_viscosity", "pressure-viscosity coefficient alpha", "1/Pa", Kind::Number(Range::NonNegative),
-        Presence::Conditional("required unless effects.viscosity = \"constant\" or lubricant.roelands_exponent is given")),
-    f!("roelands_reference_pressure", "Roelands reference pressure P_R", "Pa", Kind::Number(Range::Positive),
-        Presence::Default("1.96e8")),
-    f!("roelands_exponent", "Roelands pressure-viscosity index z_R", "", Kind::Number(Range::LeftOpen(0.0, 2.0)),
-        Presence::Default("alpha P_R / (ln eta_R + 9.67)"), note = "only with effects.viscosity = \"roelands\""),
+    f!(
+        "pressure_viscosity",
+        "pressure-viscosity coefficient alpha",
+        "1/Pa",
+        Kind::Number(Range::NonNegative),
+        Presence::Conditional("required unless effects.viscosity = \"constant\" or lubricant.roelands_exponent is given")
+    ),
+    f!("roelands_reference_pressure", "Roelands reference pressure P_R", "Pa", Kind::Number(Range::Positive), Presence::Default("1.96e8")),
+    f!(
+        "roelands_exponent",
+        "Roelands pressure-viscosity index z_R",
+        "",
+        Kind::Number(Range::LeftOpen(0.0, 2.0)),
+        Presence::Default("alpha P_R / (ln eta_R + 9.67)"),
+        note = "only with effects.viscosity = \"roelands\""
+    ),
     f!("density", "reference density rho_R", "kg/m^3", Kind::Number(Range::Positive), Presence::Default("870")),
     f!("ree_eyring_stress", "Ree-Eyring stress tau0", "Pa", Kind::Number(Range::Positive), Presence::Default("6.2e6")),
 ];
@@ -469,15 +427,29 @@ pub struct Operating {
 /// Keys of `[operating]`.
 pub const OPERATING_FIELDS: &[Field] = &[
     f!("load", "normal load L", "N", Kind::Number(Range::Positive), Presence::Required),
-    f!("entrainment_speed", "entrainment speed Ue", "m/s", Kind::Number(Range::Positive),
-        Presence::Conditional("required when effects.lubrication = \"reynolds\"")),
-    f!("slide_to_roll", "slide-to-roll ratio SRR (fraction, 0.05 = 5 %)", "", Kind::Number(Range::AbsAtMost(2.0)),
-        Presence::Default("0")),
-    f!("tilt_angle", "tilt angle lambda of the ball's rotation axis", "degrees", Kind::Number(Range::LeftOpen(0.0, 90.0)),
+    f!(
+        "entrainment_speed",
+        "entrainment speed Ue",
+        "m/s",
+        Kind::Number(Range::Positive),
+        Presence::Conditional("required when effects.lubrication = \"reynolds\"")
+    ),
+    f!("slide_to_roll", "slide-to-roll ratio SRR (fraction, 0.05 = 5 %)", "", Kind::Number(Range::AbsAtMost(2.0)), Presence::Default("0")),
+    f!(
+        "tilt_angle",
+        "tilt angle lambda of the ball's rotation axis",
+        "degrees",
+        Kind::Number(Range::LeftOpen(0.0, 90.0)),
         Presence::Default("90"),
-        note = "lambda = 0 is singular: the ball spin omega_B = U_BO/(R_B sin lambda) would be infinite"),
-    f!("friction_coefficient", "dry scene: Coulomb coefficient mu of the surface traction q = mu p in +x (effects.surface_traction = \"friction\")", "", Kind::Number(Range::Closed(0.0, 1.0)),
-        Presence::Default("0")),
+        note = "lambda = 0 is singular: the ball spin omega_B = U_BO/(R_B sin lambda) would be infinite"
+    ),
+    f!(
+        "friction_coefficient",
+        "dry scene: Coulomb coefficient mu of the surface traction q = mu p in +x (effects.surface_traction = \"friction\")",
+        "",
+        Kind::Number(Range::Closed(0.0, 1.0)),
+        Presence::Default("0")
+    ),
 ];
 
 // ---------------------------------------------------------------------------------------
@@ -502,8 +474,25 @@ pub struct Sweep {
 
 /// Keys of `[sweep]`.
 pub const SWEEP_FIELDS: &[Field] = &[
-    f!("entrainment_speed", "entrainment speeds Ue", "m/s", Kind::NumberList(Range::Positive), Presence::Default("operating.entrainment_speed")),
-    f!("tilt_angle", "tilt angles lambda", "degrees", Kind::NumberList(Range::LeftOpen(0.0, 90.0)), Presence::Default("operating.tilt_angle")),
-    f!("slide_to_roll", "slide-to-roll ratios SRR (fractions)", "", Kind::NumberList(Range::AbsAtMost(2.0)), Presence::Default("operating.slide_to_roll")),
+    f!(
+        "entrainment_speed",
+        "entrainment speeds Ue",
+        "m/s",
+        Kind::NumberList(Range::Positive),
+        Presence::Default("operating.entrainment_speed")
+    ),
+    f!(
+        "tilt_angle",
+        "tilt angles lambda",
+        "degrees",
+        Kind::NumberList(Range::LeftOpen(0.0, 90.0)),
+        Presence::Default("operating.tilt_angle")
+    ),
+    f!(
+        "slide_to_roll",
+        "slide-to-roll ratios SRR (fractions)",
+        "",
+        Kind::NumberList(Range::AbsAtMost(2.0)),
+        Presence::Default("operating.slide_to_roll")
+    ),
 ];
-

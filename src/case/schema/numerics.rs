@@ -335,27 +335,9 @@ impl Default for OutputSettings {
 
 /// Keys of `[output]`.
 pub const OUTPUT_FIELDS: &[Field] = &[
-    f!(
-        "dir",
-        "output directory",
-        "",
-        Kind::Text,
-        Presence::Default("\"out/<name>\"")
-    ),
-    f!(
-        "vtu",
-        "write VTU field files",
-        "",
-        Kind::Bool,
-        Presence::Default("true")
-    ),
-    f!(
-        "png",
-        "write PNG plots",
-        "",
-        Kind::Bool,
-        Presence::Default("true")
-    ),
+    f!("dir", "output directory", "", Kind::Text, Presence::Default("\"out/<name>\"")),
+    f!("vtu", "write VTU field files", "", Kind::Bool, Presence::Default("true")),
+    f!("png", "write PNG plots", "", Kind::Bool, Presence::Default("true")),
     f!(
         "shear_profile_z",
         "z of the rolling-direction line of the shear-stress profile (shear_profile.csv)",

@@ -186,7 +186,15 @@ impl Newton<'_> {
     /// One Newton solve of `from` with `p` at t, from `start`; the step is logged (`what`
     /// before the parameter's value) and kept in the path. Returns the report and, if
     /// converged, the state.
-    fn solve_at(&mut self, from: &Scene, p: Parameter, t: f64, system: &mut dyn EhlProblem, start: &[f64], what: &str) -> Result<(SolveReport, Option<Vec<f64>>), String> {
+    fn solve_at(
+        &mut self,
+        from: &Scene,
+        p: Parameter,
+        t: f64,
+        system: &mut dyn EhlProblem,
+        start: &[f64],
+        what: &str,
+    ) -> Result<(SolveReport, Option<Vec<f64>>), String> {
         crate::interrupt::check("the continuation")?;
         let mut sc = from.clone();
         p.apply(&mut sc, t);
@@ -203,7 +211,14 @@ impl Newton<'_> {
     /// Searches a milder problem Newton solves from `x0` (described by `label`): t from
     /// the ramp's first value, halved down to its lowest. Returns t and the converged state,
     /// or None (logged) if none converged.
-    fn search(&mut self, from: &Scene, h: &Homotopy, system: &mut dyn EhlProblem, x0: &[f64], label: &str) -> Result<Option<(f64, Vec<f64>)>, String> {
+    fn search(
+        &mut self,
+        from: &Scene,
+        h: &Homotopy,
+        system: &mut dyn EhlProblem,
+        x0: &[f64],
+        label: &str,
+    ) -> Result<Option<(f64, Vec<f64>)>, String> {
         let (p, lowest) = (h.parameter, h.ramp.lowest);
         let mut t = h.ramp.first;
         while t >= lowest {
@@ -218,7 +233,11 @@ impl Newton<'_> {
             t /= 2.0;
         }
         if t >= lowest {
-            self.note(format!("{} continuation: the film closed at {}; a smaller value gives a thinner film, so the search stops", p.name(), p.show(t)));
+            self.note(format!(
+                "{} continuation: the film closed at {}; a smaller value gives a thinner film, so the search stops",
+                p.name(),
+                p.show(t)
+            ));
         } else {
             self.note(format!("{} continuation: no milder problem converged down to {}", p.name(), p.show(lowest)));
         }
@@ -229,7 +248,14 @@ impl Newton<'_> {
     /// multiplying t by the ramp's ratio, by its square root after each failure, and giving
     /// up below a ratio of 1.05. Returns whether t = 1 converged, the last report and the
     /// last converged state.
-    fn ramp(&mut self, from: &Scene, h: &Homotopy, mut t: f64, mut state: Vec<f64>, system: &mut dyn EhlProblem) -> Result<(bool, Option<SolveReport>, Vec<f64>), String> {
+    fn ramp(
+        &mut self,
+        from: &Scene,
+        h: &Homotopy,
+        mut t: f64,
+        mut state: Vec<f64>,
+        system: &mut dyn EhlProblem,
+    ) -> Result<(bool, Option<SolveReport>, Vec<f64>), String> {
         let mut ratio = h.ramp.ratio;
         let mut last = None;
         while t < 1.0 {
@@ -261,7 +287,17 @@ impl Newton<'_> {
 /// scene's (at xi = 1e3); last the penalty from 1e3 to the scene's xi. Returns the
 /// converged iterate (gathered) or an error naming the path taken.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mut dyn EhlProblem, x0: &[f64], label: &str, policy: Policy, j: &Matrix, owned: (usize, usize), local: usize) -> Result<NewtonOutcome, String> {
+pub(super) fn newton_with_continuation(
+    ctx: &Context,
+    scene: &Scene,
+    system: &mut dyn EhlProblem,
+    x0: &[f64],
+    label: &str,
+    policy: Policy,
+    j: &Matrix,
+    owned: (usize, usize),
+    local: usize,
+) -> Result<NewtonOutcome, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     petsc::options::set_ours("-snes_linesearch_type", policy.line_search).map_err(pe)?;
     set_newton_linear_solver(policy.reuses_lu).map_err(pe)?;
@@ -295,7 +331,15 @@ pub(super) fn newton_with_continuation(ctx: &Context, scene: &Scene, system: &mu
     }
     // 1. Plain Newton from the start at the base problem.
     let report = if opts.skip_plain {
-        SolveReport { converged: false, reason: "SKIPPED".into(), reason_code: 0, iterations: 0, linear_iterations: 0, residual_norm: f64::NAN, domain_error: None }
+        SolveReport {
+            converged: false,
+            reason: "SKIPPED".into(),
+            reason_code: 0,
+            iterations: 0,
+            linear_iterations: 0,
+            residual_norm: f64::NAN,
+            domain_error: None,
+        }
     } else {
         nw.solve(&base, system, x0)?
     };

@@ -30,7 +30,13 @@ impl Collapse {
 /// for a random direction v restricted to one column block (U, P or H0), compares J v with
 /// (F(x + d v) - F(x - d v)) / (2 d) on each row block. Returns (row block, column block,
 /// relative error) for the 9 pairs. Collective.
-pub fn check_jacobian(system: &mut EhlSystem, layout: &Layout, rank: usize, x0: &[f64], j: &Matrix) -> petsc::Result<Vec<(String, String, f64)>> {
+pub fn check_jacobian(
+    system: &mut EhlSystem,
+    layout: &Layout,
+    rank: usize,
+    x0: &[f64],
+    j: &Matrix,
+) -> petsc::Result<Vec<(String, String, f64)>> {
     use crate::petsc::snes::Problem;
     let comm = petsc::comm_world();
     let n = layout.total();
@@ -39,7 +45,11 @@ pub fn check_jacobian(system: &mut EhlSystem, layout: &Layout, rank: usize, x0: 
             return 2;
         }
         let r = layout.ranges.partition_point(|&s| s <= i) - 1;
-        if i - layout.ranges[r] < layout.n_u[r] { 0 } else { 1 }
+        if i - layout.ranges[r] < layout.n_u[r] {
+            0
+        } else {
+            1
+        }
     };
     let names = ["U", "P", "H0"];
     // A generic point near the start: the Hertz start has P = 0 exactly at every node

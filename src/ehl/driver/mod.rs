@@ -20,10 +20,6 @@ pub use policy::{set_newton_defaults, set_newton_linear_solver, Coupling, CONDEN
 pub use problem::{lambda_bar, lubricant, velocity_field};
 pub use start::Start;
 
-use continuation::newton_with_continuation;
-use policy::Policy;
-use problem::ehl_params;
-use start::{elastic_start, rigid_start, start_h0};
 use super::condensed::CondensedSystem;
 use super::layout::Layout;
 use super::prealloc::preallocation;
@@ -34,6 +30,10 @@ use crate::mesh::{Mesh, Partition};
 use crate::petsc::snes::SolveReport;
 use crate::petsc::{self, Matrix};
 use crate::solid::{assembly, dofmap::DofMap};
+use continuation::newton_with_continuation;
+use policy::Policy;
+use problem::ehl_params;
+use start::{elastic_start, rigid_start, start_h0};
 
 /// Result of a converged lubricated solve (dimensionless state gathered on every rank).
 pub struct EhlSolution {
@@ -72,7 +72,15 @@ impl<'a> EhlSolver<'a> {
     /// Condenses the elastic block onto the contact face, unless the scene's
     /// `reynolds.coupling` (see [`Coupling::of_scene`]) asks for the monolithic system.
     /// Collective.
-    pub fn new(ctx: &Context, scene: &Scene, mesh: &'a Mesh, part: &'a Partition, dofs: &'a DofMap, layout: &'a Layout, half: bool) -> Result<Self, String> {
+    pub fn new(
+        ctx: &Context,
+        scene: &Scene,
+        mesh: &'a Mesh,
+        part: &'a Partition,
+        dofs: &'a DofMap,
+        layout: &'a Layout,
+        half: bool,
+    ) -> Result<Self, String> {
         set_newton_defaults().map_err(|e| e.to_string())?;
         let p_nodes = pressure_nodes(mesh, layout);
         let coupling = Coupling::of_scene(scene, p_nodes.len());
@@ -91,14 +99,18 @@ impl<'a> EhlSolver<'a> {
         }
         let t0 = std::time::Instant::now();
         let comp = if rigid {
-            ctx.log(format!("rigid solids: no elastic unknowns, H = H0 + (X^2 + Z^2)/2; sparse Newton on {} pressure unknowns", p_nodes.len()));
+            ctx.log(format!(
+                "rigid solids: no elastic unknowns, H = H0 + (X^2 + Z^2)/2; sparse Newton on {} pressure unknowns",
+                p_nodes.len()
+            ));
             Some(crate::solid::condense::Compliance::rigid(mesh.contact_nodes.clone(), p_nodes))
         } else if monolithic {
             None
         } else {
             ctx.log(format!("coupling: condensed (reynolds.coupling = \"{}\", {} pressure unknowns): the elastic block eliminated onto the contact face, a dense LU at every Newton step", scene.reynolds.coupling, p_nodes.len()));
             let eq = scene.equivalent_solid();
-            let comp = crate::solid::condense::face_compliance(&ctx.world, mesh, eq.nu, assembly::traction_factor(eq.nu), &p_nodes).map_err(|e| e.to_string())?;
+            let comp = crate::solid::condense::face_compliance(&ctx.world, mesh, eq.nu, assembly::traction_factor(eq.nu), &p_nodes)
+                .map_err(|e| e.to_string())?;
             ctx.log(format!(
                 "elastic block condensed onto the contact face: {} elastic unknowns -> {} face nodes x {} pressure nodes ({:.2} s)",
                 comp.elastic_unknowns,
@@ -143,7 +155,10 @@ impl<'a> EhlSolver<'a> {
                 match once(start, reuse_lu) {
                     Ok(s) => return Ok(s),
                     Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
-                    Err(e) if k + 1 < tries.len() => ctx.log(format!("Newton from {} with the LU reused over steps failed ({e}); again with an LU at every step", start.label())),
+                    Err(e) if k + 1 < tries.len() => ctx.log(format!(
+                        "Newton from {} with the LU reused over steps failed ({e}); again with an LU at every step",
+                        start.label()
+                    )),
                     Err(e) => ctx.log(format!("Newton from {} failed ({e}); starting over from the Hertz start", start.label())),
                 }
             }
@@ -154,7 +169,15 @@ impl<'a> EhlSolver<'a> {
 
 /// Builds and solves the EHL system of the scene on the given mesh (one operating point).
 #[allow(clippy::too_many_arguments)]
-pub fn solve(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool) -> Result<EhlSolution, String> {
+pub fn solve(
+    ctx: &Context,
+    scene: &Scene,
+    mesh: &Mesh,
+    part: &Partition,
+    dofs: &DofMap,
+    layout: &Layout,
+    half: bool,
+) -> Result<EhlSolution, String> {
     EhlSolver::new(ctx, scene, mesh, part, dofs, layout, half)?.solve(ctx, scene, None)
 }
 
@@ -166,7 +189,15 @@ fn pressure_nodes(mesh: &Mesh, layout: &Layout) -> Vec<u32> {
 
 /// The condensed path: Newton on (P, H0) with the face compliance `comp`, from the Hertz
 /// start or from a previous state `start` (monolithic layout).
-fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, comp: &crate::solid::condense::Compliance, half: bool, start: Start) -> Result<EhlSolution, String> {
+fn solve_condensed(
+    ctx: &Context,
+    scene: &Scene,
+    mesh: &Mesh,
+    layout: &Layout,
+    comp: &crate::solid::condense::Compliance,
+    half: bool,
+    start: Start,
+) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
@@ -213,8 +244,14 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
     let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);
-    ctx.log(format!("Newton from {label}: {} unknowns ({} P, 1 H0), {} Jacobian", cl.total(), cl.n_p, if comp.is_rigid() { "sparse" } else { "dense" }));
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, Policy::for_start(&start, false), &j, (lo, hi), cl.local(ctx.rank))?;
+    ctx.log(format!(
+        "Newton from {label}: {} unknowns ({} P, 1 H0), {} Jacobian",
+        cl.total(),
+        cl.n_p,
+        if comp.is_rigid() { "sparse" } else { "dense" }
+    ));
+    let out =
+        newton_with_continuation(ctx, scene, &mut system, &x0, label, Policy::for_start(&start, false), &j, (lo, hi), cl.local(ctx.rank))?;
     let solve_s = t1.elapsed().as_secs_f64();
     // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
     let uy = system.uy(&out.x);
@@ -236,7 +273,17 @@ fn solve_condensed(ctx: &Context, scene: &Scene, mesh: &Mesh, layout: &Layout, c
 /// The monolithic path: U, P and H0 in one sparse system, from the Hertz start or from a
 /// previous state `start` (same layout).
 #[allow(clippy::too_many_arguments)]
-fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition, dofs: &DofMap, layout: &Layout, half: bool, start: Start, reuse_lu: bool) -> Result<EhlSolution, String> {
+fn solve_monolithic(
+    ctx: &Context,
+    scene: &Scene,
+    mesh: &Mesh,
+    part: &Partition,
+    dofs: &DofMap,
+    layout: &Layout,
+    half: bool,
+    start: Start,
+    reuse_lu: bool,
+) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
@@ -269,10 +316,16 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
     let label = start.label();
     let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank);
     let j = Matrix::new_aij(comm, layout.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?;
-    let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene), k).map_err(pe)?;
+    let mut system =
+        EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene), k).map_err(pe)?;
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
-    ctx.log(format!("Newton from {label}: {} unknowns ({} U, {} P, 1 H0), sparse Jacobian", layout.total(), layout.counts().0, layout.counts().1));
+    ctx.log(format!(
+        "Newton from {label}: {} unknowns ({} U, {} P, 1 H0), sparse Jacobian",
+        layout.total(),
+        layout.counts().0,
+        layout.counts().1
+    ));
     if crate::ehl_options::get().check_jacobian {
         if crate::ehl_options::get().row_scaling {
             system.scale_rows(&x0).map_err(pe)?;
@@ -282,7 +335,25 @@ fn solve_monolithic(ctx: &Context, scene: &Scene, mesh: &Mesh, part: &Partition,
         }
     }
     let (lo, hi) = (layout.ranges[ctx.rank], layout.ranges[ctx.rank + 1]);
-    let out = newton_with_continuation(ctx, scene, &mut system, &x0, label, Policy::for_start(&start, reuse_lu), &j, (lo, hi), layout.local(ctx.rank))?;
+    let out = newton_with_continuation(
+        ctx,
+        scene,
+        &mut system,
+        &x0,
+        label,
+        Policy::for_start(&start, reuse_lu),
+        &j,
+        (lo, hi),
+        layout.local(ctx.rank),
+    )?;
     let solve_s = t1.elapsed().as_secs_f64();
-    Ok(EhlSolution { x: out.x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s, coupling: Coupling::Monolithic })
+    Ok(EhlSolution {
+        x: out.x,
+        report: out.report,
+        newton_total: out.newton_total,
+        steps: out.steps,
+        assembly_s,
+        solve_s,
+        coupling: Coupling::Monolithic,
+    })
 }

@@ -50,7 +50,16 @@ impl<'s> Start<'s> {
 /// satisfies the elastic rows exactly and equals the condensed path's start): the starting
 /// state of Newton.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn elastic_start(comm: petsc::ffi::MPI_Comm, ctx: &Context, mesh: &Mesh, part: &Partition, dofs: &DofMap, k: &Matrix, nu: f64, p: &dyn Fn(f64, f64) -> f64) -> petsc::Result<Vec<f64>> {
+pub(super) fn elastic_start(
+    comm: petsc::ffi::MPI_Comm,
+    ctx: &Context,
+    mesh: &Mesh,
+    part: &Partition,
+    dofs: &DofMap,
+    k: &Matrix,
+    nu: f64,
+    p: &dyn Fn(f64, f64) -> f64,
+) -> petsc::Result<Vec<f64>> {
     let nodal = |v: &[[f64; 2]; 3]| -> [f64; 6] {
         let p = crate::fem::p2tri::p2_tri_node_coords(v).map(|q| p(q[0], q[1]));
         let m = crate::fem::p2tri::p2_tri_mass(crate::fem::p2tri::tri_area(v));
@@ -88,7 +97,13 @@ pub(super) fn start_h0(hc: f64, mesh: &Mesh, uy: &dyn Fn(u32) -> f64) -> Result<
 /// (P only), and adjust H0 until its load is within 2 % of the target, by a secant method
 /// on log W(log H0) (the first step assumes W ~ 1/H0); each frozen-film solve starts from
 /// the previous pressure scaled to the target load. The full Newton finishes from there.
-pub(super) fn rigid_start(ctx: &Context, system: &mut CondensedSystem, x0: &mut [f64], (lo, hi): (usize, usize), local: usize) -> Result<(), String> {
+pub(super) fn rigid_start(
+    ctx: &Context,
+    system: &mut CondensedSystem,
+    x0: &mut [f64],
+    (lo, hi): (usize, usize),
+    local: usize,
+) -> Result<(), String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
     let n = x0.len();
@@ -100,7 +115,12 @@ pub(super) fn rigid_start(ctx: &Context, system: &mut CondensedSystem, x0: &mut 
     let x = Vector::new(comm, local).map_err(pe)?;
     // Its own options prefix: the frozen-film solves cross the cavitation penalty's kink
     // node by node and may need more iterations than the main Newton's default.
-    for (k, v) in [("-rigid_start_snes_max_it", "200"), ("-rigid_start_snes_rtol", "1e-8"), ("-rigid_start_snes_stol", "0"), ("-rigid_start_snes_linesearch_type", "bt")] {
+    for (k, v) in [
+        ("-rigid_start_snes_max_it", "200"),
+        ("-rigid_start_snes_rtol", "1e-8"),
+        ("-rigid_start_snes_stol", "0"),
+        ("-rigid_start_snes_linesearch_type", "bt"),
+    ] {
         petsc::options::set_default(k, v).map_err(pe)?;
     }
     petsc::ksp::set_direct_solver_defaults("rigid_start_").map_err(pe)?;

@@ -102,9 +102,7 @@ pub(super) struct FilmIntegrals {
 impl FilmIntegrals {
     pub(super) fn is_finite(&self) -> bool {
         let h = self.hess;
-        [self.g[0], self.g[1], h[0][0], h[0][1], h[1][1], self.phi, self.magnitude]
-            .iter()
-            .all(|v| v.is_finite())
+        [self.g[0], self.g[1], h[0][0], h[0][1], h[1][1], self.phi, self.magnitude].iter().all(|v| v.is_finite())
     }
 }
 
@@ -211,4 +209,3 @@ pub(super) fn dot(u: [f64; 2], v: [f64; 2]) -> f64 {
 pub(super) fn norm(v: [f64; 2]) -> f64 {
     v[0].hypot(v[1])
 }
-

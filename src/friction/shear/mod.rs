@@ -157,10 +157,7 @@ pub fn film_slide(law: &ShearLaw, pt: &FilmPoint, t0: [f64; 2]) -> Result<FilmSl
             let (gs, js) = (h * tau0 / eta, h / eta);
             Ok(FilmSlide {
                 slide: [gs * int.g[0], gs * int.g[1]],
-                jacobian: [
-                    [js * int.hess[0][0], js * int.hess[0][1]],
-                    [js * int.hess[1][0], js * int.hess[1][1]],
-                ],
+                jacobian: [[js * int.hess[0][0], js * int.hess[0][1]], [js * int.hess[1][0], js * int.hess[1][1]]],
             })
         }
     }
@@ -183,20 +180,13 @@ fn ree_eyring_disc_stress(tau0: f64, pt: &FilmPoint) -> Result<[f64; 2], ShearEr
         Err(Failure::Overflow) => Err(overflow(tau0, pt)),
         Err(Failure::NoConvergence { iterations, residual, tolerance }) => {
             let scale = h * tau0 / eta; // G = scale * G*
-            Err(ShearError::NoConvergence {
-                iterations,
-                residual: scale * residual,
-                tolerance: scale * tolerance,
-            })
+            Err(ShearError::NoConvergence { iterations, residual: scale * residual, tolerance: scale * tolerance })
         }
     }
 }
 
 fn overflow(tau0: f64, pt: &FilmPoint) -> ShearError {
-    ShearError::Overflow {
-        stress_range: pt.h * norm(pt.grad_p) / tau0,
-        slide_number: pt.eta * norm(pt.slide) / (pt.h * tau0),
-    }
+    ShearError::Overflow { stress_range: pt.h * norm(pt.grad_p) / tau0, slide_number: pt.eta * norm(pt.slide) / (pt.h * tau0) }
 }
 
 /// Checks h, eta > 0 finite, tau0 > 0 finite, grad_p and slide finite.

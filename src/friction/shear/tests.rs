@@ -152,9 +152,7 @@ fn newtonian_limit_for_huge_tau0() {
 #[test]
 fn newtonian_closed_form_satisfies_flow_rate_constraint() {
     let law = ShearLaw::Newtonian;
-    for (slide, grad) in
-        [([2.0, 0.0], [1e12, 0.0]), ([-0.5, 0.8], [-4e12, 7e11]), ([0.0, 0.0], [2e13, -3e13])]
-    {
+    for (slide, grad) in [([2.0, 0.0], [1e12, 0.0]), ([-0.5, 0.8], [-4e12, 7e11]), ([0.0, 0.0], [2e13, -3e13])] {
         let pt = point(grad, slide);
         let t0 = disc_shear_stress(&law, &pt).unwrap();
         let (g, mag) = simpson_slide(&law, &pt, t0, 2000);
@@ -174,9 +172,7 @@ fn newtonian_closed_form_satisfies_flow_rate_constraint() {
 #[test]
 fn strongly_non_newtonian_with_gradient_satisfies_constraint() {
     for stress_range in [5.0, 20.0, 50.0] {
-        for (n, slide_angle, grad_angle) in
-            [(0.3, 0.0, 1.0), (30.0, 2.0, -0.5), (3e3, -1.0, 2.5), (1e5, 0.4, 0.4)]
-        {
+        for (n, slide_angle, grad_angle) in [(0.3, 0.0, 1.0), (30.0, 2.0, -0.5), (3e3, -1.0, 2.5), (1e5, 0.4, 0.4)] {
             let pt = point(grad_for(stress_range, grad_angle), slide_for(n, slide_angle));
             let t0 = disc_shear_stress(&RE, &pt).unwrap();
             let (g, mag) = simpson_slide(&RE, &pt, t0, 20000);
@@ -250,11 +246,7 @@ fn jacobian_matches_finite_differences() {
             for row in 0..2 {
                 let fd = (gp[row] - gm[row]) / (2.0 * d);
                 let err = (fd - j[row][col]).abs() / jmax;
-                assert!(
-                    err < 1e-8,
-                    "s0 {s0:?}, a {a:?}, J[{row}][{col}] = {} vs fd {fd} ({err:e})",
-                    j[row][col]
-                );
+                assert!(err < 1e-8, "s0 {s0:?}, a {a:?}, J[{row}][{col}] = {} vs fd {fd} ({err:e})", j[row][col]);
             }
         }
         assert_eq!(j[0][1], j[1][0]);

@@ -2,14 +2,7 @@
 use super::*;
 
 /// Line/point plot of one or more series, optionally with log axes and a secondary y axis.
-pub fn line_plot(
-    path: &Path,
-    title: &str,
-    xlabel: &str,
-    ylabel: &str,
-    series: &[Series],
-    opts: &LineOpts,
-) -> Result<(), String> {
+pub fn line_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &[Series], opts: &LineOpts) -> Result<(), String> {
     ensure_font()?;
     check_size(opts.width, opts.height)?;
     if series.is_empty() || series.iter().all(|s| s.x.is_empty()) {
@@ -33,18 +26,13 @@ pub fn line_plot(
     let markers = series.iter().any(|s| s.style != Style::Line);
     let xr = match opts.x_range {
         Some(r) => check_range(r, opts.log_x, "x")?,
-        None => data_range(series.iter().flat_map(|s| s.x.iter().copied()), opts.log_x, if markers { 0.03 } else { 0.0 })
-            .unwrap(),
+        None => data_range(series.iter().flat_map(|s| s.x.iter().copied()), opts.log_x, if markers { 0.03 } else { 0.0 }).unwrap(),
     };
     let yr_of = |sec: bool, log: bool, given: Option<(f64, f64)>, what: &str| -> Result<(f64, f64), String> {
         match given {
             Some(r) => check_range(r, log, what),
-            None => Ok(data_range(
-                series.iter().filter(|s| s.secondary == sec).flat_map(|s| s.y.iter().copied()),
-                log,
-                0.05,
-            )
-            .unwrap_or((if log { 1.0 } else { 0.0 }, if log { 10.0 } else { 1.0 }))),
+            None => Ok(data_range(series.iter().filter(|s| s.secondary == sec).flat_map(|s| s.y.iter().copied()), log, 0.05)
+                .unwrap_or((if log { 1.0 } else { 0.0 }, if log { 10.0 } else { 1.0 }))),
         }
     };
     let yr = yr_of(false, opts.log_y, opts.y_range, "y")?;

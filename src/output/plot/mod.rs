@@ -38,9 +38,7 @@ fn load_font(path: &str) -> Result<FontVec, String> {
 }
 
 fn font() -> Result<&'static FontVec, String> {
-    FONT.get_or_init(|| load_font(FONT_FILE.get().map_or(FONT_PATH, |f| f.as_str())))
-        .as_ref()
-        .map_err(|e| e.clone())
+    FONT.get_or_init(|| load_font(FONT_FILE.get().map_or(FONT_PATH, |f| f.as_str()))).as_ref().map_err(|e| e.clone())
 }
 
 /// Loads the plot font once (from [`set_font_file`] or [`FONT_PATH`]); every plot function calls it

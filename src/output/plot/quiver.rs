@@ -17,14 +17,7 @@ pub(super) fn draw_arrow(cv: &mut Canvas, tail: (f64, f64), tip: (f64, f64), c: 
 
 /// Arrow plot of a vector field: each entry is `[x, y, u, v]`; arrows are centred on (x, y).
 /// A reference arrow with its length in `opts.unit` is drawn under the plot.
-pub fn quiver_plot(
-    path: &Path,
-    title: &str,
-    xlabel: &str,
-    ylabel: &str,
-    arrows: &[[f64; 4]],
-    opts: &QuiverOpts,
-) -> Result<(), String> {
+pub fn quiver_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, arrows: &[[f64; 4]], opts: &QuiverOpts) -> Result<(), String> {
     ensure_font()?;
     check_size(opts.width, opts.height)?;
     if arrows.is_empty() {

@@ -58,11 +58,7 @@ fn font_loads_or_names_the_package() {
 fn hertz_pressure_map() {
     let (tris, vals) = square_mesh(3.0, 60, |x, y| (1.0 - x * x - y * y).max(0.0).sqrt());
     let path = test_dir().join("map_hertz.png");
-    let opts = MapOpts {
-        circle: Some((0.0, 0.0, 1.0)),
-        colorbar_label: "p / p_H".to_string(),
-        ..Default::default()
-    };
+    let opts = MapOpts { circle: Some((0.0, 0.0, 1.0)), colorbar_label: "p / p_H".to_string(), ..Default::default() };
     map_plot(&path, "Hertz pressure", "x / a", "y / a", &tris, &vals, &opts).unwrap();
     let img = read_png(&path);
     assert!(img.0 <= opts.width && img.1 <= opts.height && img.0 >= 500 && img.1 >= 300, "{}x{}", img.0, img.1);
@@ -82,12 +78,7 @@ fn diverging_shear_map() {
     let (tris, vals) = square_mesh(2.0, 40, |x, y| 3e6 * x * (-(x * x + y * y)).exp());
     let tris: Vec<_> = tris.iter().map(|t| t.map(|p| [p[0], 0.5 * p[1]])).collect();
     let path = test_dir().join("map_shear.png");
-    let opts = MapOpts {
-        diverging: true,
-        circle: Some((0.0, 0.0, 0.8)),
-        colorbar_label: "τ_xz [Pa]".to_string(),
-        ..Default::default()
-    };
+    let opts = MapOpts { diverging: true, circle: Some((0.0, 0.0, 0.8)), colorbar_label: "τ_xz [Pa]".to_string(), ..Default::default() };
     map_plot(&path, "Shear stress on the contact plane", "x [mm]", "y [mm]", &tris, &vals, &opts).unwrap();
     let img = read_png(&path);
     assert!(img.0 <= opts.width && img.1 <= opts.height && img.0 >= 500 && img.1 >= 300, "{}x{}", img.0, img.1);
@@ -142,8 +133,7 @@ fn loglog_convergence() {
     // narrow log range (less than a decade) and log-x only
     let s = vec![Series::new("", vec![200.0, 300.0, 700.0], vec![1.0, 2.0, 1.5], Style::Points)];
     let path = test_dir().join("narrow_logx.png");
-    line_plot(&path, "", "n", "y", &s, &LineOpts { log_x: true, width: 600, height: 400, ..Default::default() })
-        .unwrap();
+    line_plot(&path, "", "n", "y", &s, &LineOpts { log_x: true, width: 600, height: 400, ..Default::default() }).unwrap();
     assert_eq!(read_png(&path).0, 600);
     let t: Vec<String> = log_ticks(200.0, 700.0).into_iter().filter_map(|t| t.label).collect();
     assert_eq!(t, ["200", "300", "400", "500", "600", "700"]);
