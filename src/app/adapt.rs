@@ -277,13 +277,19 @@ fn add_accuracy_to_summary(ctx: &Context, dir: &std::path::Path, target: f64, le
         "reached": est.iter().all(|&e| e < target),
         "estimated_error": { "hc": est[0], "hm": est[1] },
         "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8)",
-        "levels": levels.iter().enumerate().map(|(k, l)| json!({
-            "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
-            "contact_triangles": l.contact_triangles, "smallest_size_a": l.min_size,
-            "newton_iterations": l.newton_iterations, "seconds": l.seconds,
-            "hc_m": l.hc, "hm_m": l.hm, "pmax_pa": l.pmax,
-            "estimated_error": l.est.map(|e| json!({ "hc": e[0], "hm": e[1] })),
-        })).collect::<Vec<_>>(),
+        "levels": levels.iter().enumerate().map(|(k, l)| {
+            let mut v = json!({
+                "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
+                "contact_triangles": l.contact_triangles, "smallest_size_a": l.min_size,
+                "newton_iterations": l.newton_iterations, "seconds": l.seconds,
+                "hc_m": l.hc, "hm_m": l.hm, "pmax_pa": l.pmax,
+            });
+            // The first level has no estimate: the key is left out (summary.json holds no null).
+            if let Some(e) = l.est {
+                v["estimated_error"] = json!({ "hc": e[0], "hm": e[1] });
+            }
+            v
+        }).collect::<Vec<_>>(),
     });
     ctx.write_summary_to(dir, &summary)
 }
