@@ -47,24 +47,25 @@ impl EarlierRun {
         let text = crate::case::read_bounded(&summary_path, 16 << 20).map_err(|e| {
             err(format!("cannot read {}: {e} (the folder of a converged lubricated run is expected)", summary_path.display()))
         })?;
-        let summary = match Summary::from_json(&text) {
-            Ok(s) => s,
-            Err(_) if serde_json::from_str::<DrySummary>(&text).is_ok() => {
-                return Err(err("the earlier run is a dry (Hertz) run: it has no film to start from".into()))
-            }
-            Err(e) => {
-                return Err(err(format!("{} is not the summary of a lubricated run this version can read: {e}", summary_path.display())))
-            }
-        };
-        if !summary.converged {
+        // Checked in the order a user can act on: the file is JSON, the scene it stores is
+        // valid (it may have been edited), the run converged, then the rest of its fields.
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| err(format!("{} is not valid JSON: {e}", summary_path.display())))?;
+        if serde_json::from_value::<DrySummary>(value.clone()).is_ok() {
+            return Err(err("the earlier run is a dry (Hertz) run: it has no film to start from".into()));
+        }
+        let stored: Scene = serde_json::from_value(value["scene"].clone())
+            .map_err(|e| err(format!("{} holds no scene this version can read: {e}", summary_path.display())))?;
+        let bad_scene = |e: String| err(format!("the scene stored in {} is not valid: {e}", summary_path.display()));
+        stored.validate().map_err(|e| bad_scene(e.to_string()))?;
+        stored.plausibility().map_err(|e| bad_scene(e.to_string()))?;
+        super::check_mesh(&stored).map_err(bad_scene)?;
+        if value["converged"].as_bool() != Some(true) {
             return Err(err(format!("{} is not the summary of a converged run (\"converged\" is not true)", summary_path.display())));
         }
+        let summary = Summary::from_json(&text)
+            .map_err(|e| err(format!("{} is not the summary of a lubricated run this version can read: {e}", summary_path.display())))?;
         let (scene, hc_m, half) = (summary.scene, summary.film.hc_m, summary.solver.half_domain);
-        // The stored scene is checked as a scene file would be: it may have been edited.
-        let bad_scene = |e: String| err(format!("the scene stored in {} is not valid: {e}", summary_path.display()));
-        scene.validate().map_err(|e| bad_scene(e.to_string()))?;
-        scene.plausibility().map_err(|e| bad_scene(e.to_string()))?;
-        super::check_mesh(&scene).map_err(bad_scene)?;
         if !hc_m.is_finite() {
             return Err(err(format!("{} has no finite film.hc_m", summary_path.display())));
         }
