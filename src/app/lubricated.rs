@@ -569,6 +569,26 @@ fn write_plots(
         y_range: Some((-1.3, 1.3)),
         ..opts("h (um)", Some((0.0, 1.5 * fields.stats().hc * hs * 1e6)))
     };
+    // The face mesh the film was solved on (an adaptive run's last level) over the film.
+    let mut edges: Vec<[[f64; 2]; 2]> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    for tri in &mesh.contact_tris {
+        for e in 0..3 {
+            let (a, b) = (tri[e], tri[(e + 1) % 3]);
+            if seen.insert((a.min(b), a.max(b))) {
+                let (pa, pb) = (mesh.nodes[a as usize], mesh.nodes[b as usize]);
+                edges.push([[pa[0], pa[2]], [pb[0], pb[2]]]);
+                if fields.half() {
+                    edges.push([[pa[0], -pa[2]], [pb[0], -pb[2]]]);
+                }
+            }
+        }
+    }
+    let with_mesh = MapOpts { edges, ..opts("h (um)", Some((0.0, h_top))) };
+    let path = dir.join("film_mesh.png");
+    crate::output::write_atomic_with(&path, |t| {
+        map_plot(t, "contact-face mesh over the film (colours saturate at 4 hc)", "x / a", "z / a", &tris, &hv, &with_mesh)
+    })?;
     let path = dir.join("film_map_contact.png");
     crate::output::write_atomic_with(&path, |t| {
         map_plot(t, "film thickness in the contact (colours saturate at 1.5 hc)", "x / a", "z / a", &tris, &hv, &zoom)

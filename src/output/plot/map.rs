@@ -124,6 +124,10 @@ pub fn map_plot(
             }
         }
     }
+    check_finite(opts.edges.iter().flatten().flatten().copied(), "map_plot: edges")?;
+    for e in &opts.edges {
+        cv.stroke(&[(x.px(e[0][0]), y.px(e[0][1])), (x.px(e[1][0]), y.px(e[1][1]))], 0.6, (30, 30, 30), bx);
+    }
     if let Some(c) = opts.circle {
         draw_circle(&mut cv, &x, &y, c, bx);
     }

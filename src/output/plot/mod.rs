@@ -171,6 +171,8 @@ pub struct MapOpts {
     /// Visible part of the plane; default the bounding box of the triangles.
     pub x_range: Option<(f64, f64)>,
     pub y_range: Option<(f64, f64)>,
+    /// Line segments drawn over the colours in data units (e.g. the edges of a mesh).
+    pub edges: Vec<[[f64; 2]; 2]>,
 }
 
 impl Default for MapOpts {
@@ -185,6 +187,7 @@ impl Default for MapOpts {
             range: None,
             x_range: None,
             y_range: None,
+            edges: Vec::new(),
         }
     }
 }
