@@ -20,6 +20,7 @@ use crate::ehl::driver::{self, EhlSolution, EhlSolver, Start};
 use crate::ehl::post::FieldsOnFace;
 use crate::mesh::size_field::SizeField;
 use crate::mesh::spec::dyadic_size;
+use crate::mesh::Mesh;
 use crate::reynolds::estimate::{dorfler_mark, element_residual};
 use serde_json::json;
 use std::collections::HashMap;
@@ -89,10 +90,7 @@ fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
     // low to the high vertex, summed over the two triangles that share it.
     let mut jumps: HashMap<(u32, u32), EdgeFluxes> = HashMap::new();
     for (k, tri) in mesh.contact_tris.iter().enumerate() {
-        let verts = [0, 1, 2].map(|i| {
-            let c = mesh.nodes[tri[i] as usize];
-            [c[0], c[2]]
-        });
+        let verts = mesh.contact_tri_xz(k);
         let p = tri.map(|n| fields.p_node(n));
         let h = tri.map(|n| fields.h_node(n));
         let v = verts.map(|x| vel(x[0], x[1]));
@@ -119,36 +117,26 @@ fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
     eta
 }
 
-/// Length of the longest edge of contact triangle `k` (units of a).
-fn longest_edge(fields: &FieldsOnFace, k: usize) -> f64 {
-    let tri = fields.mesh.contact_tris[k];
-    let p = [0, 1, 2].map(|i| fields.mesh.nodes[tri[i] as usize]);
-    (0..3).map(|e| (p[e][0] - p[(e + 1) % 3][0]).hypot(p[e][2] - p[(e + 1) % 3][2])).fold(0.0, f64::max)
+/// Length of the longest edge of every contact triangle (units of a).
+fn longest_edges(mesh: &Mesh) -> Vec<f64> {
+    (0..mesh.contact_tris.len())
+        .map(|k| {
+            let p = mesh.contact_tri_xz(k);
+            (0..3).map(|e| (p[e][0] - p[(e + 1) % 3][0]).hypot(p[e][1] - p[(e + 1) % 3][1])).fold(0.0, f64::max)
+        })
+        .collect()
 }
 
 /// The size field of the next level: marked triangles at half their size, the others at
 /// theirs (a triangle of a Kuhn cell of size h has its longest edge h sqrt 2, or h one
-/// bisection further; both halve to h/2 and keep h).
-fn next_field(fields: &FieldsOnFace, marked: &[bool], growth: f64) -> SizeField {
-    let mesh = fields.mesh;
-    let sizes: Vec<f64> = (0..mesh.contact_tris.len())
-        .map(|k| {
-            let e = longest_edge(fields, k);
-            if marked[k] {
-                dyadic_size(0.5 * e).max(MIN_ADAPTIVE_SIZE)
-            } else {
-                dyadic_size(e)
-            }
-        })
-        .collect();
+/// bisection further; both halve to h/2 and keep h). `edges`: [`longest_edges`].
+fn next_field(mesh: &Mesh, edges: &[f64], marked: &[bool], growth: f64) -> SizeField {
+    let sizes: Vec<f64> =
+        edges.iter().zip(marked).map(|(&e, &m)| if m { dyadic_size(0.5 * e).max(MIN_ADAPTIVE_SIZE) } else { dyadic_size(e) }).collect();
     let smallest = sizes.iter().cloned().fold(f64::INFINITY, f64::min);
     let mut f = SizeField::new(mesh.spec.contact, 0.5 * smallest, growth, mesh.spec.contact_size);
-    for (k, tri) in mesh.contact_tris.iter().enumerate() {
-        let v = [0, 1, 2].map(|i| {
-            let c = mesh.nodes[tri[i] as usize];
-            [c[0], c[2]]
-        });
-        f.impose_triangle(&v, sizes[k]);
+    for (k, &size) in sizes.iter().enumerate() {
+        f.impose_triangle(&mesh.contact_tri_xz(k), size);
     }
     f.grade();
     f
@@ -164,16 +152,17 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     ));
     let mut levels: Vec<Level> = Vec::new();
     let mut field: Option<Arc<SizeField>> = None;
-    let mut previous: Option<(Setup, EhlSolution)> = None;
+    // The last level's setup, solution and (dimensionless) central film.
+    let mut previous: Option<(Setup, EhlSolution, f64)> = None;
     let growth = scene.mesh.growth;
     for k in 0..=max_levels {
         let t0 = Instant::now();
         let setup = Setup::with_size_field(ctx, scene, field.clone())?;
         let solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
         let sol = match (&previous, earlier) {
-            (Some((ps, psol)), _) => {
+            (Some((ps, psol, hc)), _) => {
                 let pf = FieldsOnFace::new(&ps.mesh, &ps.layout, &psol.x);
-                let hc = pf.stats().hc;
+                let hc = *hc;
                 let p = |x: f64, z: f64| pf.at(x, z).map_or(0.0, |v| v.0);
                 let label = format!("level {}'s pressure ({} contact triangles)", k - 1, ps.mesh.contact_tris.len());
                 solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc, label: &label })?
@@ -188,8 +177,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         }
         let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
         let (n_u, n_p) = setup.layout.counts();
-        let min_size =
-            (0..setup.mesh.contact_tris.len()).map(|t| longest_edge(&fields, t)).fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
+        let edges = longest_edges(&setup.mesh);
+        let min_size = edges.iter().cloned().fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
         let mut level = Level {
             elastic_unknowns: n_u,
             pressure_unknowns: n_p,
@@ -240,13 +229,13 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             });
         }
         let eta = indicators(scene, &fields);
-        let eligible: Vec<bool> = (0..eta.len()).map(|t| longest_edge(&fields, t) > 1.5 * MIN_ADAPTIVE_SIZE).collect();
+        let eligible: Vec<bool> = edges.iter().map(|&e| e > 1.5 * MIN_ADAPTIVE_SIZE).collect();
         let mut marked = dorfler_mark(&eta, &eligible, scene.accuracy.marking);
         // The pressurised zone is refined everywhere as well: hc and hm are carried there
         // (the film is transported from the inlet build-up through the Hertz zone to the
         // side lobes and the outlet), and a change between levels measures their error
-        // only where the mesh changed (with the indicator alone the estimate fell 4-25
-        // times below the error against independent references).
+        // only where the mesh changed (with the indicator alone the estimate fell far
+        // below the error against independent references: docs/accuracy.md).
         for (t, tri) in setup.mesh.contact_tris.iter().enumerate() {
             if eligible[t] && tri.iter().any(|&n| fields.p_node(n) > PRESSURISED) {
                 marked[t] = true;
@@ -257,9 +246,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 "accuracy: target {target} not reached: every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"
             ));
         }
-        field = Some(Arc::new(next_field(&fields, &marked, growth)));
+        field = Some(Arc::new(next_field(&setup.mesh, &edges, &marked, growth)));
         drop(solver);
-        previous = Some((setup, sol));
+        previous = Some((setup, sol, st.hc));
         crate::interrupt::check("adaptive refinement")?;
     }
     unreachable!("the loop returns at max_levels")

@@ -141,6 +141,15 @@ impl Mesh {
         (0..self.tets.len()).map(|t| self.tet_volume(t)).sum()
     }
 
+    /// The `(x, z)` coordinates of the three vertices of contact triangle `k`.
+    pub fn contact_tri_xz(&self, k: usize) -> [[f64; 2]; 3] {
+        let c = &self.contact_tris[k];
+        [0, 1, 2].map(|i| {
+            let p = self.nodes[c[i] as usize];
+            [p[0], p[2]]
+        })
+    }
+
     /// Signed `(x, z)` area of contact triangle `k` (positive by construction).
     pub fn contact_tri_area(&self, k: usize) -> f64 {
         let c = &self.contact_tris[k];
