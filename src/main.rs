@@ -18,7 +18,8 @@ The solver's own options (-ehl_monitor, -ehl_check_jacobian, -ehl_supg_delta, ..
   with the others by -help after the scene.
 Exit codes: 0 success, 1 solve failed or did not converge, 2 bad command line, scene or output folder
   (also an output folder in use by another run), 3 MPI or PETSc start-up (all ranks end),
-  130/143 interrupted by SIGINT/SIGTERM (all ranks stop at the next check; no result of the
+  4 result written but its accuracy target not reached (summary.json: accuracy.reached = false,
+  with the estimated error), 130/143 interrupted by SIGINT/SIGTERM (all ranks stop at the next check; no result of the
   interrupted solve is written).";
 
 /// Full-system FEM solver for elastohydrodynamic lubrication (EHL) of circular contacts

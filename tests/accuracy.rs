@@ -58,3 +58,39 @@ fn a_target_is_refused_where_it_cannot_apply() {
         assert!(t.contains("accuracy.target") && t.contains(why), "{scene}: {t}");
     }
 }
+
+/// A level that would exceed `accuracy.max_unknowns` is not solved: the last level's result
+/// is written, labelled (summary.json `accuracy.reached = false`, with the estimate and the
+/// reason), and the run exits 4, so that a sweep can tell it from a converged result and
+/// from a failed solve. The M = 10 point from 0.5 a: level 1 has about 44,000 unknowns and
+/// level 2 about 123,000, so a budget of 60,000 stops after level 1.
+#[test]
+fn a_level_over_the_unknowns_budget_is_not_solved_and_the_run_says_so() {
+    let dir = scratch("accuracy_budget");
+    let scene = repo().join("cases/examples/moes-m10-l6.toml");
+    let out = mpirun(
+        2,
+        &[
+            scene.to_str().unwrap(),
+            "--output",
+            dir.join("run").to_str().unwrap(),
+            "--set",
+            "accuracy.target=0.05",
+            "--set",
+            "accuracy.max_unknowns=60000",
+            "--set",
+            "mesh.contact_size=0.5",
+        ],
+    );
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(4), "{log}");
+    assert!(log.contains("accuracy.max_unknowns = 60000") && log.contains("not reached"), "{log}");
+    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("run/summary.json")).unwrap()).unwrap();
+    let acc = &s["accuracy"];
+    assert_eq!(acc["reached"], false, "{acc}");
+    assert_eq!(acc["levels"].as_array().unwrap().len(), 2, "{acc}");
+    assert!(acc["not_reached_because"].as_str().unwrap().contains("max_unknowns"), "{acc}");
+    // The written film is level 1's, and its estimate is reported with it.
+    assert_eq!(s["film"]["hc_m"], acc["levels"][1]["hc_m"], "{s}");
+    assert!(acc["estimated_error"]["hc"].as_f64().unwrap() > 0.0, "{acc}");
+}

@@ -11,11 +11,15 @@
 //!    the last two levels, e_k = |Q_k - Q_{k-1}| max(1, rho/(1 - rho)) with rho the observed
 //!    ratio of the last two changes (capped at 0.8): for a sequence converging by a factor
 //!    rho per level the remaining error is rho/(1 - rho) times the last change. Stop when
-//!    every estimate is below the target (from level 2 on, so that rho is measured), or
-//!    fail honestly after `accuracy.max_levels`.
+//!    every estimate is below the target (from level 2 on, so that rho is measured).
+//! 6. When the target cannot be reached (`accuracy.max_levels` levels solved, the next
+//!    level above `accuracy.max_unknowns`, or every triangle at the smallest size), the
+//!    last level's result is written with its estimated error, `accuracy.reached` is
+//!    false and the run exits 4: a result, honestly labelled, rather than none.
 use super::lubricated::{post_point, Setup};
 use super::Context;
 use crate::case::Scene;
+use crate::collective;
 use crate::ehl::driver::{self, EhlSolution, EhlSolver, Start};
 use crate::ehl::post::FieldsOnFace;
 use crate::mesh::size_field::SizeField;
@@ -142,30 +146,68 @@ fn next_field(mesh: &Mesh, edges: &[f64], marked: &[bool], growth: f64) -> SizeF
     f
 }
 
+/// A solved level kept for the next one: its setup, solution, dimensionless central film
+/// and condensation time.
+struct Solved {
+    setup: Setup,
+    sol: EhlSolution,
+    hc: f64,
+    condensation_s: Option<f64>,
+}
+
 /// Runs the adaptive loop of a lubricated single-point scene with `accuracy.target > 0`.
-/// Collective.
+/// Collective. When the target cannot be reached (`max_levels`, `max_unknowns`, every
+/// triangle at the smallest size) the last level's result is written with its estimated
+/// error and `ctx.shortfall` says why (exit 4).
 pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<(), String> {
-    let target = scene.accuracy.target;
-    let max_levels = scene.accuracy.max_levels as usize;
+    let acc = scene.accuracy;
+    let target = acc.target;
+    let max_levels = acc.max_levels as usize;
     ctx.log(format!(
-        "accuracy: target {target} (relative error of hc and hm): adaptive refinement of the contact face, at most {max_levels} levels after the first"
+        "accuracy: target {target} (relative error of hc and hm): adaptive refinement of the contact face, at most {max_levels} levels after the first and {} unknowns per level",
+        acc.max_unknowns
     ));
     let mut levels: Vec<Level> = Vec::new();
     let mut field: Option<Arc<SizeField>> = None;
-    // The last level's setup, solution and (dimensionless) central film.
-    let mut previous: Option<(Setup, EhlSolution, f64)> = None;
+    let mut previous: Option<Solved> = None;
     let growth = scene.mesh.growth;
     for k in 0..=max_levels {
         let t0 = Instant::now();
         let setup = Setup::with_size_field(ctx, scene, field.clone())?;
+        let (n_u, n_p) = setup.layout.counts();
+        if let (Some(prev), true) = (&previous, (n_u + n_p + 1) as u64 > acc.max_unknowns) {
+            let why = format!(
+                "accuracy: target {target} not reached: level {k} would have {} unknowns, above accuracy.max_unknowns = {}; the result of level {} is written with its estimated error ({})",
+                n_u + n_p + 1,
+                acc.max_unknowns,
+                k - 1,
+                describe(levels.last().and_then(|l| l.est))
+            );
+            return finish(ctx, scene, prev, target, &levels, Some(why));
+        }
         let solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
         let sol = match (&previous, earlier) {
-            (Some((ps, psol, hc)), _) => {
-                let pf = FieldsOnFace::new(&ps.mesh, &ps.layout, &psol.x);
-                let hc = *hc;
+            (Some(prev), _) => {
+                let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
                 let p = |x: f64, z: f64| pf.at(x, z).map_or(0.0, |v| v.0);
-                let label = format!("level {}'s pressure ({} contact triangles)", k - 1, ps.mesh.contact_tris.len());
-                solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc, label: &label })?
+                let label = format!("level {}'s pressure ({} contact triangles)", k - 1, prev.setup.mesh.contact_tris.len());
+                let solved =
+                    collective::agree(&ctx.world, solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc: prev.hc, label: &label }));
+                match solved {
+                    Ok(sol) => sol,
+                    // A level that does not converge leaves the last converged one as the
+                    // result, labelled as short of its target (an interruption stops).
+                    Err(e) if crate::interrupt::agreed() == 0 => {
+                        let why = format!(
+                            "accuracy: target {target} not reached: level {k} did not converge ({e}); the result of level {} is written with its estimated error ({})",
+                            k - 1,
+                            describe(levels.last().and_then(|l| l.est))
+                        );
+                        drop(solver);
+                        return finish(ctx, scene, prev, target, &levels, Some(why));
+                    }
+                    Err(e) => return Err(e),
+                }
             }
             (None, Some(e)) => e.solve(ctx, scene, &solver)?,
             (None, None) => solver.solve(ctx, scene, None)?,
@@ -176,7 +218,6 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             return Err(format!("accuracy: level {k} converged to an unphysical state (hc {}, hm {}); no result written", st.hc, st.hm));
         }
         let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
-        let (n_u, n_p) = setup.layout.counts();
         let edges = longest_edges(&setup.mesh);
         let min_size = edges.iter().cloned().fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
         let mut level = Level {
@@ -206,65 +247,92 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             level.hc,
             level.hm,
             level.pmax,
-            level.est.map_or("- (first level)".to_string(), |e| format!("hc {:.2} %, hm {:.2} %", 100.0 * e[0], 100.0 * e[1]))
+            level.est.map_or("- (first level)".to_string(), |e| describe(Some(e)))
         ));
         let reached = k >= 2 && level.est.is_some_and(|e| e.iter().all(|&v| v < target));
+        let est = level.est;
         levels.push(level);
-        if reached || k == max_levels {
-            if !reached {
-                return Err(format!(
-                    "accuracy: target {target} not reached after {max_levels} refinement levels (estimated error hc {:.2} %, hm {:.2} %); raise accuracy.max_levels or the target",
-                    100.0 * levels[k].est.map_or(f64::NAN, |e| e[0]),
-                    100.0 * levels[k].est.map_or(f64::NAN, |e| e[1])
-                ));
-            }
+        let condensation_s = solver.condensation_s;
+        drop(fields);
+        drop(solver);
+        let here = Solved { setup, sol, hc: st.hc, condensation_s };
+        if reached {
             ctx.log(format!("accuracy: target {target} reached at level {k}"));
-            crate::interrupt::check("the Newton solve")?;
-            return ctx.write_results(|dir| {
-                post_point(ctx, scene, &setup, &sol, solver.condensation_s, dir)?;
-                if ctx.rank == 0 {
-                    add_accuracy_to_summary(ctx, dir, target, &levels)?;
-                }
-                Ok(())
-            });
+            return finish(ctx, scene, &here, target, &levels, None);
         }
+        if k == max_levels {
+            let why = format!(
+                "accuracy: target {target} not reached after accuracy.max_levels = {max_levels} refinement levels; the last level's result is written with its estimated error ({})",
+                describe(est)
+            );
+            return finish(ctx, scene, &here, target, &levels, Some(why));
+        }
+        let fields = FieldsOnFace::new(&here.setup.mesh, &here.setup.layout, &here.sol.x);
         let eta = indicators(scene, &fields);
         let eligible: Vec<bool> = edges.iter().map(|&e| e > 1.5 * MIN_ADAPTIVE_SIZE).collect();
-        let mut marked = dorfler_mark(&eta, &eligible, scene.accuracy.marking);
+        let mut marked = dorfler_mark(&eta, &eligible, acc.marking);
         // The pressurised zone is refined everywhere as well: hc and hm are carried there
         // (the film is transported from the inlet build-up through the Hertz zone to the
         // side lobes and the outlet), and a change between levels measures their error
         // only where the mesh changed (with the indicator alone the estimate fell far
         // below the error against independent references: docs/accuracy.md).
-        for (t, tri) in setup.mesh.contact_tris.iter().enumerate() {
+        for (t, tri) in here.setup.mesh.contact_tris.iter().enumerate() {
             if eligible[t] && tri.iter().any(|&n| fields.p_node(n) > PRESSURISED) {
                 marked[t] = true;
             }
         }
         if !marked.iter().any(|&m| m) {
-            return Err(format!(
-                "accuracy: target {target} not reached: every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"
-            ));
+            let why = format!(
+                "accuracy: target {target} not reached: every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a; the result of level {k} is written with its estimated error ({})",
+                describe(est)
+            );
+            return finish(ctx, scene, &here, target, &levels, Some(why));
         }
-        field = Some(Arc::new(next_field(&setup.mesh, &edges, &marked, growth)));
-        drop(solver);
-        previous = Some((setup, sol, st.hc));
+        field = Some(Arc::new(next_field(&here.setup.mesh, &edges, &marked, growth)));
+        previous = Some(here);
         crate::interrupt::check("adaptive refinement")?;
     }
     unreachable!("the loop returns at max_levels")
 }
 
+/// "hc x %, hm y %", or "none: one level" without an estimate.
+fn describe(est: Option<[f64; 2]>) -> String {
+    est.map_or("none: a single level".to_string(), |e| format!("hc {:.2} %, hm {:.2} %", 100.0 * e[0], 100.0 * e[1]))
+}
+
+/// Writes the result of `done` (the last level solved) with the accuracy report; with a
+/// `shortfall` the report says the target was not reached and the run exits 4.
+fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Level], shortfall: Option<String>) -> Result<(), String> {
+    crate::interrupt::check("the Newton solve")?;
+    ctx.write_results(|dir| {
+        post_point(ctx, scene, &done.setup, &done.sol, done.condensation_s, dir)?;
+        if ctx.rank == 0 {
+            add_accuracy_to_summary(ctx, dir, target, levels, shortfall.as_deref())?;
+        }
+        Ok(())
+    })?;
+    if let Some(why) = shortfall {
+        ctx.log(&why);
+        *ctx.shortfall.borrow_mut() = Some(why);
+    }
+    Ok(())
+}
+
 /// Adds `accuracy` (target, estimates, levels) to the summary.json that post_point wrote.
-fn add_accuracy_to_summary(ctx: &Context, dir: &std::path::Path, target: f64, levels: &[Level]) -> Result<(), String> {
+fn add_accuracy_to_summary(
+    ctx: &Context,
+    dir: &std::path::Path,
+    target: f64,
+    levels: &[Level],
+    shortfall: Option<&str>,
+) -> Result<(), String> {
     let path = dir.join("summary.json");
     let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let mut summary: serde_json::Value = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
     let last = levels.last().expect("a level");
-    let est = last.est.unwrap_or([f64::NAN; 2]);
     summary["accuracy"] = json!({
         "target": target,
-        "reached": est.iter().all(|&e| e < target),
-        "estimated_error": { "hc": est[0], "hm": est[1] },
+        "reached": shortfall.is_none(),
         "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8)",
         "levels": levels.iter().enumerate().map(|(k, l)| {
             let mut v = json!({
@@ -280,6 +348,12 @@ fn add_accuracy_to_summary(ctx: &Context, dir: &std::path::Path, target: f64, le
             v
         }).collect::<Vec<_>>(),
     });
+    if let Some(e) = last.est {
+        summary["accuracy"]["estimated_error"] = json!({ "hc": e[0], "hm": e[1] });
+    }
+    if let Some(why) = shortfall {
+        summary["accuracy"]["not_reached_because"] = json!(why);
+    }
     ctx.write_summary_to(dir, &summary)
 }
 

@@ -109,7 +109,7 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             return 2;
         }
     };
-    let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
+    let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start, shortfall: Default::default() };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {
         Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => {
@@ -120,7 +120,15 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
     };
     let failed_here = result.is_err();
     let code = match collective::agree(&ctx.world, result) {
-        Ok(()) => 0,
+        Ok(()) => match ctx.shortfall.borrow().as_deref() {
+            None => 0,
+            Some(why) => {
+                if rank == 0 {
+                    eprintln!("ehl-petsc: warning: {why}");
+                }
+                4
+            }
+        },
         Err(e) => {
             // A failure every rank shares (Newton, an interruption) is printed once, by
             // rank 0; a rank that failed alone prints its own message.
@@ -135,7 +143,7 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
         }
     };
     if let Some(c) = &claim {
-        c.release(code == 0);
+        c.release(code == 0 || code == 4);
     }
     if rank == 0 {
         // -options_left style: the user's PETSc options that nothing queried (misspelt, or

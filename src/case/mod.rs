@@ -116,6 +116,7 @@ pub fn parse_scene_with(text: &str, default_name: &str, overrides: &[String]) ->
     }
     spec::check_table(SCENE_FIELDS, &table, SCENE_FIELDS, "")?;
     let hand_mesh = table.contains_key("mesh");
+    let inlet_given = table.get("reynolds").and_then(|r| r.as_table()).is_some_and(|r| r.contains_key("x_min"));
     let mut scene = Scene::deserialize(toml::Value::Table(table))
         .map_err(|e| SceneErrorKind::Syntax(format!("scene does not match the schema: {e}")))?;
     if scene.accuracy.target < 0.0 {
@@ -126,6 +127,12 @@ pub fn parse_scene_with(text: &str, default_name: &str, overrides: &[String]) ->
             && scene.effects.elasticity == ElasticityModel::Elastic
             && scene.sweep.is_none();
         scene.accuracy.target = if adaptive { schema::DEFAULT_ACCURACY_TARGET } else { 0.0 };
+        if adaptive {
+            scene.mesh.growth = schema::ADAPTIVE_GROWTH;
+            if !inlet_given {
+                scene.reynolds.x_min = schema::ADAPTIVE_X_MIN;
+            }
+        }
     }
     if scene.name.is_empty() {
         if default_name.trim().is_empty() {

@@ -225,12 +225,29 @@ pub struct Accuracy {
     /// Fraction theta of the total indicator that the marked elements carry (Doerfler
     /// marking); default 0.5.
     pub marking: f64,
+    /// Most unknowns a level may have: a level that would exceed it is not solved, and the
+    /// last level's result is written with its estimated error (exit 4); default 600,000.
+    pub max_unknowns: u64,
 }
+
+/// Default of `accuracy.max_unknowns`: about 6.5 GB per rank on 2 ranks with MUMPS (the
+/// peak of a level grows like its unknowns to the power 1.2-1.4).
+pub const DEFAULT_MAX_UNKNOWNS: u64 = 600_000;
+
+/// Element size growth of a mesh refined adaptively by default (no `[mesh]` table): the
+/// solid under the refined face coarsens by one element size per unit depth.
+pub const ADAPTIVE_GROWTH: f64 = 1.0;
+
+/// Inlet edge x_min/a of a scene refined adaptively by default that does not set it: the
+/// classic Reynolds domain of the multigrid literature (X from -4.5). At light loads the
+/// inlet build-up reaches beyond X = -3 (Moes M = 10, L = 6: hc 1.5 % and hm 2.9 % low
+/// on X >= -3), and an accuracy target must not be capped by the domain.
+pub const ADAPTIVE_X_MIN: f64 = -4.5;
 
 impl Default for Accuracy {
     fn default() -> Self {
         // target < 0: not given (the parser fills it in).
-        Accuracy { target: -1.0, max_levels: 8, marking: 0.5 }
+        Accuracy { target: -1.0, max_levels: 8, marking: 0.5, max_unknowns: DEFAULT_MAX_UNKNOWNS }
     }
 }
 
@@ -257,6 +274,14 @@ pub const ACCURACY_FIELDS: &[Field] = &[
         "",
         Kind::Number(Range::Closed(0.1, 0.9)),
         Presence::Default("0.5")
+    ),
+    f!(
+        "max_unknowns",
+        "most unknowns (elastic + pressure + h0) a refinement level may have",
+        "",
+        Kind::Number(Range::Closed(1e4, 1e9)),
+        Presence::Default("600000"),
+        note = "a level that would exceed it is not solved: the last level's result is written with its estimated error, summary.json says accuracy.reached = false, and the exit code is 4 (about 6.5 GB per rank on 2 ranks at 600,000; raise it on a larger machine)"
     ),
 ];
 
