@@ -280,6 +280,8 @@ pub fn post_point(
     };
     let prof_x0 = profile([0.0, r.z0], [0.0, r.z1])?;
     let prof_z0 = profile([r.x0, 0.0], [r.x1, 0.0])?;
+    // Wiggles of the same two lines (docs/accuracy.md, "Smooth fields").
+    let jumps = [fields.slope_jump([0.0, r.z0], [0.0, r.z1], 20001).0, fields.slope_jump([r.x0, 0.0], [r.x1, 0.0], 20001).0];
     res.profile_x0 = prof_x0.iter().map(|r| [r[1] / a, r[3]]).collect();
     let with_tau = friction.is_some();
     write_profiles(dir, "profile_x0.csv", &prof_x0, with_tau)?;
@@ -360,6 +362,8 @@ pub fn post_point(
             pmin_pa: st.pmin * ph,
             pmin_nodes_pa: st.pmin_nodes * ph,
             load_error_rel: load_error,
+            slope_jump_x0: Some(jumps[0]),
+            slope_jump_z0: Some(jumps[1]),
         },
         moes: scene.moes().map(|m| MoesSummary { m: m.m, l: m.l }),
         solver: SolverSummary {

@@ -119,19 +119,20 @@ pub fn parse_scene_with(text: &str, default_name: &str, overrides: &[String]) ->
     let inlet_given = table.get("reynolds").and_then(|r| r.as_table()).is_some_and(|r| r.contains_key("x_min"));
     let mut scene = Scene::deserialize(toml::Value::Table(table))
         .map_err(|e| SceneErrorKind::Syntax(format!("scene does not match the schema: {e}")))?;
+    // A lubricated, elastic, single-point scene whose mesh nobody made by hand is refined
+    // to the default target when it gives none; refined adaptively (its own target or the
+    // default) it also gets the adaptive mesh defaults (docs/accuracy.md).
+    let refinable = !hand_mesh
+        && scene.effects.lubrication == LubricationModel::Reynolds
+        && scene.effects.elasticity == ElasticityModel::Elastic
+        && scene.sweep.is_none();
     if scene.accuracy.target < 0.0 {
-        // Not given: a lubricated, elastic, single-point scene whose mesh nobody made by
-        // hand is refined to the default target.
-        let adaptive = !hand_mesh
-            && scene.effects.lubrication == LubricationModel::Reynolds
-            && scene.effects.elasticity == ElasticityModel::Elastic
-            && scene.sweep.is_none();
-        scene.accuracy.target = if adaptive { schema::DEFAULT_ACCURACY_TARGET } else { 0.0 };
-        if adaptive {
-            scene.mesh.growth = schema::ADAPTIVE_GROWTH;
-            if !inlet_given {
-                scene.reynolds.x_min = schema::ADAPTIVE_X_MIN;
-            }
+        scene.accuracy.target = if refinable { schema::DEFAULT_ACCURACY_TARGET } else { 0.0 };
+    }
+    if refinable && scene.accuracy.target > 0.0 {
+        scene.mesh.growth = schema::ADAPTIVE_GROWTH;
+        if !inlet_given {
+            scene.reynolds.x_min = schema::ADAPTIVE_X_MIN;
         }
     }
     if scene.name.is_empty() {

@@ -556,3 +556,24 @@ fn subsurface_keys_are_checked_together() {
         .unwrap();
     assert!(s.warnings().iter().any(|w| w.contains("mesh.core_depth")), "{:?}", s.warnings());
 }
+
+#[test]
+fn a_scene_without_mesh_keys_is_refined_with_the_adaptive_defaults() {
+    let minimal = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/cases/examples/minimal.toml")).unwrap();
+    // No [mesh], no target: the default target, growth 1.0, the inlet at X = -4.5.
+    let s = parse_scene(&minimal, "m").unwrap();
+    assert_eq!(s.accuracy.target, crate::case::schema::DEFAULT_ACCURACY_TARGET);
+    assert_eq!((s.mesh.growth, s.reynolds.x_min), (1.0, -4.5));
+    // Its own target: the same mesh defaults (a target given with --set behaves the same).
+    let s = parse_scene_with(&minimal, "m", &["accuracy.target=0.005".into()]).unwrap();
+    assert_eq!((s.accuracy.target, s.mesh.growth, s.reynolds.x_min), (0.005, 1.0, -4.5));
+    // An inlet the scene gives is kept.
+    let s = parse_scene_with(&minimal, "m", &["reynolds.x_min=-6".into()]).unwrap();
+    assert_eq!((s.mesh.growth, s.reynolds.x_min), (1.0, -6.0));
+    // A [mesh] key: the hand-made mesh as given, no refinement, the plain defaults.
+    let s = parse_scene_with(&minimal, "m", &["mesh.contact_size=0.25".into()]).unwrap();
+    assert_eq!((s.accuracy.target, s.mesh.growth, s.reynolds.x_min), (0.0, 0.5, -3.0));
+    // Target 0 on a scene without [mesh]: the plain defaults.
+    let s = parse_scene_with(&minimal, "m", &["accuracy.target=0".into()]).unwrap();
+    assert_eq!((s.mesh.growth, s.reynolds.x_min), (0.5, -3.0));
+}

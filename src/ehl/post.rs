@@ -104,6 +104,67 @@ impl<'a> FieldsOnFace<'a> {
         FilmStats { hc, hm, hm_at, pmax, pmax_at, load, h0: self.x[self.layout.h0 as usize], pmin, pmin_nodes }
     }
 
+    /// dP/ds of contact triangle `k`'s P2 pressure at (x, z) along the unit direction
+    /// `dir` (the triangle's polynomial, also just outside it). (x, z) is in the solved
+    /// half when the mesh is a half domain; `mirrored` flips the z derivative.
+    fn slope_in(&self, k: usize, x: f64, z: f64, dir: [f64; 2], mirrored: bool) -> f64 {
+        let tri = self.mesh.contact_tris[k];
+        let geo = crate::fem::geometry::AffineTri::new(&self.mesh.contact_tri_xz(k));
+        let l = self.mesh.contact_barycentric(k, x, z);
+        let d = crate::fem::p2tri::p2_tri_grads_bary(l, &geo.grad_bary);
+        let (mut gx, mut gz) = (0.0, 0.0);
+        for (i, &n) in tri.iter().enumerate() {
+            let p = self.p_node(n);
+            gx += p * d[i][0];
+            gz += p * d[i][1];
+        }
+        if mirrored {
+            gz = -gz;
+        }
+        gx * dir[0] + gz * dir[1]
+    }
+
+    /// Node-to-node wiggles of the pressure along the segment from `a` to `b`: the largest
+    /// jump of the slope dP/ds between neighbouring contact triangles, in p_H/a, and where.
+    /// The P2 pressure of a smooth field has slope jumps that vanish like h^2 |P'''|; a
+    /// wiggle is a jump of the order of the pressure variation over an element divided by
+    /// its size. The segment is sampled `n` times; at every change of triangle both
+    /// polynomials are differentiated at the same point (the midpoint of the two samples).
+    pub fn slope_jump(&self, a: [f64; 2], b: [f64; 2], n: usize) -> (f64, [f64; 2]) {
+        let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let dir = [(b[0] - a[0]) / len, (b[1] - a[1]) / len];
+        let point = |i: usize| {
+            let t = i as f64 / (n - 1) as f64;
+            [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+        };
+        let tri_at = |q: [f64; 2]| self.locate(q[0], q[1]).map(|(k, _)| k);
+        let (mut worst, mut at) = (0.0, [f64::NAN; 2]);
+        let mut prev = tri_at(point(0));
+        for i in 1..n {
+            let (q0, q) = (point(i - 1), point(i));
+            let here = tri_at(q);
+            let crosses_plane = self.half() && (q0[1] > 0.0) != (q[1] > 0.0);
+            if let (Some(k0), Some(k1)) = (prev, here) {
+                if k0 != k1 || crosses_plane {
+                    let m = [0.5 * (q0[0] + q[0]), 0.5 * (q0[1] + q[1])];
+                    // On the mirrored half of a half domain a triangle is differentiated at
+                    // the mirror image of the point, its z derivative flipped.
+                    let side = |k: usize, qz: f64| {
+                        let mirrored = self.half() && qz > 0.0;
+                        self.slope_in(k, m[0], if mirrored { -m[1] } else { m[1] }, dir, mirrored)
+                    };
+                    let jump = (side(k1, q[1]) - side(k0, q0[1])).abs();
+                    if jump > worst {
+                        worst = jump;
+                        at = m;
+                    }
+                }
+            }
+            prev = here;
+        }
+        (worst, at)
+    }
+
     /// Samples (X, Z, P, H) on the segment from `a` to `b` with `n` points.
     pub fn profile(&self, a: [f64; 2], b: [f64; 2], n: usize) -> Vec<[f64; 4]> {
         (0..n)
@@ -113,5 +174,54 @@ impl<'a> FieldsOnFace<'a> {
                 self.at(x, z).map(|(p, h)| [x, z, p, h])
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{generate, partition, MeshSpec, Rect};
+    use crate::solid::dofmap::DofMap;
+
+    /// A coarse mesh (0.5 a contact grid on [-3, 3]^2), its layout and a state vector
+    /// whose nodal pressures are `p(X, Z)`.
+    fn state(p: impl Fn(f64, f64) -> f64) -> (Mesh, Layout, Vec<f64>) {
+        let mut spec = MeshSpec::paper_default();
+        spec.contact_size = 0.5;
+        let mesh = generate(&spec).unwrap();
+        let part = partition(&mesh, 1);
+        let dofs = DofMap::new(&mesh, &part, 1);
+        let rect = Rect { x0: -3.0, x1: 3.0, z0: -3.0, z1: 3.0 };
+        let layout = Layout::new(&mesh, &part, &dofs, &rect, false, 1);
+        let mut x = vec![0.0; layout.h0 as usize + 1];
+        for &n in &mesh.contact_nodes {
+            let d = layout.p[n as usize];
+            if d >= 0 {
+                let c = mesh.nodes[n as usize];
+                x[d as usize] = p(c[0], c[2]);
+            }
+        }
+        (mesh, layout, x)
+    }
+
+    #[test]
+    fn the_slope_jump_is_zero_for_a_quadratic_and_the_kink_or_wiggle_otherwise() {
+        // A quadratic is reproduced by P2: no slope jumps (round-off only). The segments keep
+        // off the elements next to the rectangle's edges, where P = 0 (Dirichlet).
+        let (m, l, x) = state(|x, z| 1.0 - 0.1 * x * x - 0.05 * x * z + 0.02 * z * z);
+        let f = FieldsOnFace::new(&m, &l, &x);
+        let (j, _) = f.slope_jump([-2.4, 0.1], [2.4, 0.1], 2001);
+        assert!(j < 1e-9, "quadratic: {j}");
+        // A kink |X| on the mesh line X = 0: the slope jumps from -1 to +1 there.
+        let (m, l, x) = state(|x, _| x.abs());
+        let f = FieldsOnFace::new(&m, &l, &x);
+        let (j, at) = f.slope_jump([-2.4, 0.1], [2.4, 0.1], 2001);
+        assert!((j - 2.0).abs() < 1e-9 && at[0].abs() < 0.01, "kink: {j} at {at:?}");
+        // A node-to-node wiggle of amplitude 0.01 on 0.25-spaced P2 nodes: slope jumps of
+        // order 0.01 / 0.25 times a few.
+        let (m, l, x) = state(|x, _| 0.01 * ((4.0 * x).round() as i64 % 2) as f64);
+        let f = FieldsOnFace::new(&m, &l, &x);
+        let (j, _) = f.slope_jump([-2.4, 0.1], [2.4, 0.1], 2001);
+        assert!(j > 0.04, "wiggle: {j}");
     }
 }

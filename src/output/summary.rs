@@ -124,6 +124,13 @@ pub struct PressureSummary {
     pub pmin_nodes_pa: f64,
     #[serde(deserialize_with = "nan_if_null")]
     pub load_error_rel: f64,
+    /// Node-to-node wiggles of the centre-line profiles: the largest jump of the pressure
+    /// slope between neighbouring contact triangles along X = 0 and along Z = 0, in p_H/a
+    /// (absent in summaries written before it existed).
+    #[serde(default)]
+    pub slope_jump_x0: Option<f64>,
+    #[serde(default)]
+    pub slope_jump_z0: Option<f64>,
 }
 
 /// Moes' parameters M and L.
