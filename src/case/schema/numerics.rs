@@ -113,11 +113,11 @@ impl Default for ReynoldsDomain {
 
 /// Keys of `[reynolds]`.
 pub const REYNOLDS_FIELDS: &[Field] = &[
-    f!("x_min", "inlet edge of the Reynolds rectangle x_min/a", "a", Kind::Number(Range::AtMost(-1.0)), Presence::Default("-3; -4.5 for a scene refined adaptively by default (no [mesh] table)"),
+    f!("x_min", "inlet edge of the Reynolds rectangle x_min/a", "a", Kind::Number(Range::AtMost(-1.0)), Presence::Default("-3; -4.5 when refined to an accuracy target without a [mesh] table"),
         note = "the rectangle must contain the Hertz circle and lie inside the top face: |x_min| < mesh.cube_size/2"),
     f!("x_max", "outlet edge of the Reynolds rectangle x_max/a", "a", Kind::Number(Range::AtLeast(1.0)), Presence::Default("3"),
         note = "the rectangle must contain the Hertz circle and lie inside the top face: x_max < mesh.cube_size/2"),
-    f!("z_min", "side edge of the Reynolds rectangle z_min/a", "a", Kind::Number(Range::AtMost(-1.0)), Presence::Default("-3; -4.5 for a scene refined adaptively by default (no [mesh] table)"),
+    f!("z_min", "side edge of the Reynolds rectangle z_min/a", "a", Kind::Number(Range::AtMost(-1.0)), Presence::Default("-3"),
         note = "the rectangle must contain the Hertz circle and lie inside the top face: |z_min| < mesh.cube_size/2"),
     f!("z_max", "side edge of the Reynolds rectangle z_max/a", "a", Kind::Number(Range::AtLeast(1.0)), Presence::Default("3"),
         note = "the rectangle must contain the Hertz circle and lie inside the top face: z_max < mesh.cube_size/2"),
@@ -231,7 +231,7 @@ pub const MESH_FIELDS: &[Field] = &[
         "element size growth per unit distance from the contact",
         "",
         Kind::Number(Range::LeftOpen(0.0, 2.0)),
-        Presence::Default("0.5; 1.0 for a scene refined adaptively by default (no [mesh] table)")
+        Presence::Default("0.5; 1.0 when refined to an accuracy target without a [mesh] table")
     ),
     f!(
         "core_size",
