@@ -3,6 +3,29 @@
 mod common;
 use common::*;
 
+/// Runs the M = 10, L = 6 example from a 0.5 a first mesh to target 0.05 on 2 ranks, with one
+/// more `--set KEY=VALUE`, in `scratch(name)/run`; returns the run and its summary (Null
+/// when none was written).
+fn moes_m10(name: &str, set: &str) -> (std::process::Output, serde_json::Value) {
+    let dir = scratch(name);
+    let scene = repo().join("cases/examples/moes-m10-l6.toml");
+    let run = dir.join("run");
+    let args = [
+        scene.to_str().unwrap(),
+        "--output",
+        run.to_str().unwrap(),
+        "--set",
+        "accuracy.target=0.05",
+        "--set",
+        set,
+        "--set",
+        "mesh.contact_size=0.5",
+    ];
+    let out = mpirun(2, &args);
+    let summary = std::fs::read_to_string(run.join("summary.json")).map_or(serde_json::Value::Null, |t| serde_json::from_str(&t).unwrap());
+    (out, summary)
+}
+
 /// A lightly loaded Moes point (M = 10, L = 6, Barus, incompressible) on a coarse first mesh
 /// (0.5 a) with target 0.05: three levels or more, each with more unknowns, the estimates
 /// in summary.json below the target, and hc, hm within 5 % (the target) plus 1 % (what the
@@ -11,24 +34,8 @@ use common::*;
 /// hm 0.3126 um (Venner-Lubrecht full multigrid, 1025^2, extrapolated).
 #[test]
 fn a_moes_point_is_refined_to_its_target() {
-    let dir = scratch("accuracy_moes");
-    let scene = repo().join("cases/examples/moes-m10-l6.toml");
-    let out = mpirun(
-        2,
-        &[
-            scene.to_str().unwrap(),
-            "--output",
-            dir.join("run").to_str().unwrap(),
-            "--set",
-            "accuracy.target=0.05",
-            "--set",
-            "accuracy.max_levels=4",
-            "--set",
-            "mesh.contact_size=0.5",
-        ],
-    );
+    let (out, s) = moes_m10("accuracy_moes", "accuracy.max_levels=4");
     assert!(out.status.success(), "{}", text(&out));
-    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("run/summary.json")).unwrap()).unwrap();
     let acc = &s["accuracy"];
     assert_eq!(acc["reached"], true, "{acc}");
     let levels = acc["levels"].as_array().unwrap();
@@ -72,26 +79,10 @@ fn a_target_is_refused_where_it_cannot_apply() {
 /// level 2 about 123,000, so a budget of 60,000 stops after level 1.
 #[test]
 fn a_level_over_the_unknowns_budget_is_not_solved_and_the_run_says_so() {
-    let dir = scratch("accuracy_budget");
-    let scene = repo().join("cases/examples/moes-m10-l6.toml");
-    let out = mpirun(
-        2,
-        &[
-            scene.to_str().unwrap(),
-            "--output",
-            dir.join("run").to_str().unwrap(),
-            "--set",
-            "accuracy.target=0.05",
-            "--set",
-            "accuracy.max_unknowns=60000",
-            "--set",
-            "mesh.contact_size=0.5",
-        ],
-    );
+    let (out, s) = moes_m10("accuracy_budget", "accuracy.max_unknowns=60000");
     let log = text(&out);
     assert_eq!(out.status.code(), Some(4), "{log}");
     assert!(log.contains("accuracy.max_unknowns = 60000") && log.contains("not reached"), "{log}");
-    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("run/summary.json")).unwrap()).unwrap();
     let acc = &s["accuracy"];
     assert_eq!(acc["reached"], false, "{acc}");
     assert_eq!(acc["levels"].as_array().unwrap().len(), 2, "{acc}");

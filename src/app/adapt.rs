@@ -176,13 +176,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let setup = Setup::with_size_field(ctx, scene, field.clone())?;
         let (n_u, n_p) = setup.layout.counts();
         if let (Some(prev), true) = (&previous, (n_u + n_p + 1) as u64 > acc.max_unknowns) {
-            let why = format!(
-                "accuracy: target {target} not reached: level {k} would have {} unknowns, above accuracy.max_unknowns = {}; the result of level {} is written with its estimated error ({})",
-                n_u + n_p + 1,
-                acc.max_unknowns,
-                k - 1,
-                describe(levels.last().and_then(|l| l.est))
-            );
+            let why = format!("level {k} would have {} unknowns, above accuracy.max_unknowns = {}", n_u + n_p + 1, acc.max_unknowns);
+            let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
             return finish(ctx, scene, prev, target, &levels, Some(why));
         }
         let solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
@@ -198,11 +193,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     // A level that does not converge leaves the last converged one as the
                     // result, labelled as short of its target (an interruption stops).
                     Err(e) if crate::interrupt::agreed() == 0 => {
-                        let why = format!(
-                            "accuracy: target {target} not reached: level {k} did not converge ({e}); the result of level {} is written with its estimated error ({})",
-                            k - 1,
-                            describe(levels.last().and_then(|l| l.est))
-                        );
+                        let why = short_of(target, &format!("level {k} did not converge ({e})"), k - 1, levels.last().and_then(|l| l.est));
                         drop(solver);
                         return finish(ctx, scene, prev, target, &levels, Some(why));
                     }
@@ -252,6 +243,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let reached = k >= 2 && level.est.is_some_and(|e| e.iter().all(|&v| v < target));
         let est = level.est;
         levels.push(level);
+        // The next level's marking, while this level's fields are at hand (not when it is the last).
+        let marked = (!reached && k < max_levels).then(|| mark(scene, &fields, &edges, acc.marking));
         let condensation_s = solver.condensation_s;
         drop(fields);
         drop(solver);
@@ -261,31 +254,12 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             return finish(ctx, scene, &here, target, &levels, None);
         }
         if k == max_levels {
-            let why = format!(
-                "accuracy: target {target} not reached after accuracy.max_levels = {max_levels} refinement levels; the last level's result is written with its estimated error ({})",
-                describe(est)
-            );
+            let why = short_of(target, &format!("accuracy.max_levels = {max_levels} refinement levels solved"), k, est);
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
-        let fields = FieldsOnFace::new(&here.setup.mesh, &here.setup.layout, &here.sol.x);
-        let eta = indicators(scene, &fields);
-        let eligible: Vec<bool> = edges.iter().map(|&e| e > 1.5 * MIN_ADAPTIVE_SIZE).collect();
-        let mut marked = dorfler_mark(&eta, &eligible, acc.marking);
-        // The pressurised zone is refined everywhere as well: hc and hm are carried there
-        // (the film is transported from the inlet build-up through the Hertz zone to the
-        // side lobes and the outlet), and a change between levels measures their error
-        // only where the mesh changed (with the indicator alone the estimate fell far
-        // below the error against independent references: docs/accuracy.md).
-        for (t, tri) in here.setup.mesh.contact_tris.iter().enumerate() {
-            if eligible[t] && tri.iter().any(|&n| fields.p_node(n) > PRESSURISED) {
-                marked[t] = true;
-            }
-        }
+        let marked = marked.expect("marked when the loop goes on");
         if !marked.iter().any(|&m| m) {
-            let why = format!(
-                "accuracy: target {target} not reached: every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a; the result of level {k} is written with its estimated error ({})",
-                describe(est)
-            );
+            let why = short_of(target, &format!("every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"), k, est);
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
         field = Some(Arc::new(next_field(&here.setup.mesh, &edges, &marked, growth)));
@@ -293,6 +267,34 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         crate::interrupt::check("adaptive refinement")?;
     }
     unreachable!("the loop returns at max_levels")
+}
+
+/// The triangles the next level halves: Doerfler marking of the indicators plus the whole
+/// pressurised zone, never below [`MIN_ADAPTIVE_SIZE`]. `edges`: [`longest_edges`].
+fn mark(scene: &Scene, fields: &FieldsOnFace, edges: &[f64], marking: f64) -> Vec<bool> {
+    let eta = indicators(scene, fields);
+    let eligible: Vec<bool> = edges.iter().map(|&e| e > 1.5 * MIN_ADAPTIVE_SIZE).collect();
+    let mut marked = dorfler_mark(&eta, &eligible, marking);
+    // The pressurised zone is refined everywhere as well: hc and hm are carried there
+    // (the film is transported from the inlet build-up through the Hertz zone to the
+    // side lobes and the outlet), and a change between levels measures their error
+    // only where the mesh changed (with the indicator alone the estimate fell far
+    // below the error against independent references: docs/accuracy.md).
+    for (t, tri) in fields.mesh.contact_tris.iter().enumerate() {
+        if eligible[t] && tri.iter().any(|&n| fields.p_node(n) > PRESSURISED) {
+            marked[t] = true;
+        }
+    }
+    marked
+}
+
+/// The message of a run that stops short of `target`: why, and which level's result is
+/// written with which estimate.
+fn short_of(target: f64, why: &str, level: usize, est: Option<[f64; 2]>) -> String {
+    format!(
+        "accuracy: target {target} not reached: {why}; the result of level {level} is written with its estimated error ({})",
+        describe(est)
+    )
 }
 
 /// "hc x %, hm y %", or "none: one level" without an estimate.

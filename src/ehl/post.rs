@@ -108,16 +108,9 @@ impl<'a> FieldsOnFace<'a> {
     /// `dir` (the triangle's polynomial, also just outside it). (x, z) is in the solved
     /// half when the mesh is a half domain; `mirrored` flips the z derivative.
     fn slope_in(&self, k: usize, x: f64, z: f64, dir: [f64; 2], mirrored: bool) -> f64 {
-        let tri = self.mesh.contact_tris[k];
-        let geo = crate::fem::geometry::AffineTri::new(&self.mesh.contact_tri_xz(k));
-        let l = self.mesh.contact_barycentric(k, x, z);
-        let d = crate::fem::p2tri::p2_tri_grads_bary(l, &geo.grad_bary);
-        let (mut gx, mut gz) = (0.0, 0.0);
-        for (i, &n) in tri.iter().enumerate() {
-            let p = self.p_node(n);
-            gx += p * d[i][0];
-            gz += p * d[i][1];
-        }
+        let geo = crate::fem::AffineTri::new(&self.mesh.contact_tri_xz(k));
+        let p = self.mesh.contact_tris[k].map(|n| self.p_node(n));
+        let [gx, mut gz] = crate::fem::p2_tri_eval_grad(&p, self.mesh.contact_barycentric(k, x, z), &geo.grad_bary);
         if mirrored {
             gz = -gz;
         }

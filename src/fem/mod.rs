@@ -37,6 +37,6 @@ pub use geometry::{tet_signed_volume, AffineTet, AffineTri};
 pub use loads::{body_force_load, tri_normal_load};
 pub use norms::{h1_seminorm_error_sq, l2_error_sq};
 pub use p2tet::{p2_tet_basis, p2_tet_eval, p2_tet_eval_scalar, p2_tet_ref_grads};
-pub use p2tri::{p2_tri_basis, p2_tri_eval, p2_tri_ref_grads};
+pub use p2tri::{p2_tri_basis, p2_tri_eval, p2_tri_eval_grad, p2_tri_ref_grads};
 pub use quadrature::{tet_rule, tri_rule, QuadRule, TetRule, TriRule};
 pub use testmesh::kuhn_box_mesh;

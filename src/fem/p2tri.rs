@@ -71,6 +71,20 @@ pub fn p2_tri_eval(values: &[f64; 6], bary: [f64; 3]) -> f64 {
     n.iter().zip(values).map(|(n, v)| n * v).sum()
 }
 
+/// Gradient of a P2 scalar field on a triangle (6 nodal values) at barycentric point `bary`,
+/// from the gradients `g` of the barycentric coordinates ([`crate::fem::AffineTri`]'s
+/// `grad_bary`); `bary` may lie outside the triangle (the polynomial extended).
+#[inline]
+pub fn p2_tri_eval_grad(values: &[f64; 6], bary: [f64; 3], g: &[[f64; 2]; 3]) -> [f64; 2] {
+    let d = p2_tri_grads_bary(bary, g);
+    let mut grad = [0.0; 2];
+    for (dk, v) in d.iter().zip(values) {
+        grad[0] += dk[0] * v;
+        grad[1] += dk[1] * v;
+    }
+    grad
+}
+
 /// Coordinates of the 6 P2 nodes of a straight-sided triangle with the given vertices.
 #[inline]
 pub fn p2_tri_node_coords(verts: &[[f64; 2]; 3]) -> [[f64; 2]; 6] {

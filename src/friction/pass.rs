@@ -10,7 +10,7 @@
 //! share is small because the viscosity is low and the film thick).
 use super::shear::{disc_shear_stress, FilmPoint, ShearLaw};
 use crate::fem::geometry::AffineTri;
-use crate::fem::p2tri::{p2_tri_basis_bary, p2_tri_grads_bary};
+use crate::fem::p2tri::{p2_tri_eval, p2_tri_eval_grad};
 use crate::mesh::spec::Rect;
 use crate::mesh::Mesh;
 use crate::physics::Kinematics;
@@ -102,15 +102,7 @@ impl TriFields {
     /// The shear stress on the disc at barycentric point `b` (Pa).
     fn stress(&self, s: &FrictionSetup, b: [f64; 3]) -> Result<[f64; 2], String> {
         let (v, p, h) = (&self.v, &self.p, &self.h);
-        let phi = p2_tri_basis_bary(b);
-        let dphi = p2_tri_grads_bary(b, &self.geo.grad_bary);
-        let (mut pv, mut hv, mut g) = (0.0, 0.0, [0.0; 2]);
-        for k in 0..6 {
-            pv += phi[k] * p[k];
-            hv += phi[k] * h[k];
-            g[0] += dphi[k][0] * p[k];
-            g[1] += dphi[k][1] * p[k];
-        }
+        let (pv, hv, g) = (p2_tri_eval(p, b), p2_tri_eval(h, b), p2_tri_eval_grad(p, b, &self.geo.grad_bary));
         let (x, z) = ((0..3).map(|i| b[i] * v[i][0]).sum::<f64>(), (0..3).map(|i| b[i] * v[i][1]).sum::<f64>());
         let (xm, zm) = (x * s.a, z * s.a);
         let vel = s.kinematics.at(xm, zm);
