@@ -55,12 +55,71 @@ pub struct Level {
     pub hc: f64,
     pub hm: f64,
     pub pmax: f64,
-    /// Estimated relative errors of hc and hm (None on level 0).
-    pub est: Option<[f64; 2]>,
+    /// Friction coefficients fx, fz (scenes with friction).
+    pub friction: Option<[f64; 2]>,
+    /// Estimated errors (None on level 0).
+    pub est: Option<Estimate>,
+}
+
+/// The estimated relative errors of a level's target quantities: hc and hm, and with
+/// friction fx and fz, each relative to the magnitude of the friction coefficient
+/// sqrt(fx^2 + fz^2) (fz vanishes by symmetry without spin, so its own size is no scale).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    pub hc: f64,
+    pub hm: f64,
+    pub friction: Option<[f64; 2]>,
+}
+
+impl Estimate {
+    /// The estimate of the last level of `levels`, None before the second level.
+    fn of(levels: &[Level]) -> Option<Estimate> {
+        let series = |f: &dyn Fn(&Level) -> f64| levels.iter().map(f).collect::<Vec<f64>>();
+        let hc = estimate(&series(&|l| l.hc))?;
+        let hm = estimate(&series(&|l| l.hm))?;
+        let friction = levels.iter().map(|l| l.friction).collect::<Option<Vec<[f64; 2]>>>().and_then(|f| {
+            let last = f.last()?;
+            let scale = last[0].hypot(last[1]);
+            let fx: Vec<f64> = f.iter().map(|v| v[0]).collect();
+            let fz: Vec<f64> = f.iter().map(|v| v[1]).collect();
+            Some([estimate_scaled(&fx, scale)?, estimate_scaled(&fz, scale)?])
+        });
+        Some(Estimate { hc, hm, friction })
+    }
+
+    /// Every estimated error.
+    fn values(&self) -> Vec<f64> {
+        let mut v = vec![self.hc, self.hm];
+        v.extend(self.friction.iter().flatten());
+        v
+    }
+
+    /// "hc x %, hm y %" (and fx, fz).
+    fn describe(&self) -> String {
+        let mut s = format!("hc {:.2} %, hm {:.2} %", 100.0 * self.hc, 100.0 * self.hm);
+        if let Some([fx, fz]) = self.friction {
+            s.push_str(&format!(", fx {:.2} %, fz {:.2} %", 100.0 * fx, 100.0 * fz));
+        }
+        s
+    }
+
+    fn json(&self) -> serde_json::Value {
+        let mut v = json!({ "hc": self.hc, "hm": self.hm });
+        if let Some([fx, fz]) = self.friction {
+            v["fx"] = json!(fx);
+            v["fz"] = json!(fz);
+        }
+        v
+    }
 }
 
 /// The estimated relative error of the last value of `q` (see the module documentation).
 pub fn estimate(q: &[f64]) -> Option<f64> {
+    estimate_scaled(q, q.last()?.abs())
+}
+
+/// The estimated error of the last value of `q` relative to `scale`.
+fn estimate_scaled(q: &[f64], scale: f64) -> Option<f64> {
     let n = q.len();
     if n < 2 {
         return None;
@@ -73,7 +132,7 @@ pub fn estimate(q: &[f64]) -> Option<f64> {
     } else {
         1.0
     };
-    Some(factor * d1 / q[n - 1].abs())
+    Some(factor * d1 / scale)
 }
 
 /// The outward fluxes of an edge at its two Gauss points summed over its triangles, the
@@ -164,7 +223,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let target = acc.target;
     let max_levels = acc.max_levels as usize;
     ctx.log(format!(
-        "accuracy: target {target} (relative error of hc and hm): adaptive refinement of the contact face, at most {max_levels} levels after the first and {} unknowns per level",
+        "accuracy: target {target} (relative error of hc and hm{}): adaptive refinement of the contact face, at most {max_levels} levels after the first and {} unknowns per level",
+        if scene.effects.friction == crate::case::FrictionModel::Off { "" } else { ", fx and fz" },
         acc.max_unknowns
     ));
     let mut levels: Vec<Level> = Vec::new();
@@ -221,15 +281,14 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             hc: st.hc * hs,
             hm: st.hm * hs,
             pmax: st.pmax * ph,
+            friction: level_friction(scene, &fields)?,
             est: None,
         };
-        let hcs: Vec<f64> = levels.iter().map(|l| l.hc).chain([level.hc]).collect();
-        let hms: Vec<f64> = levels.iter().map(|l| l.hm).chain([level.hm]).collect();
-        if let (Some(ec), Some(em)) = (estimate(&hcs), estimate(&hms)) {
-            level.est = Some([ec, em]);
-        }
+        levels.push(level.clone());
+        level.est = Estimate::of(&levels);
+        levels.pop();
         ctx.log(format!(
-            "accuracy: level {k}: {} contact triangles (smallest {:.4} a), {} unknowns, {} Newton its, {:.1} s: hc = {:.5e} m, hm = {:.5e} m, pmax = {:.4e} Pa; estimated error {}",
+            "accuracy: level {k}: {} contact triangles (smallest {:.4} a), {} unknowns, {} Newton its, {:.1} s: hc = {:.5e} m, hm = {:.5e} m, pmax = {:.4e} Pa{}; estimated error {}",
             level.contact_triangles,
             level.min_size,
             n_u + n_p + 1,
@@ -238,9 +297,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             level.hc,
             level.hm,
             level.pmax,
-            level.est.map_or("- (first level)".to_string(), |e| describe(Some(e)))
+            level.friction.map_or(String::new(), |f| format!(", fx = {:.5e}, fz = {:.5e}", f[0], f[1])),
+            level.est.map_or("- (first level)".to_string(), |e| e.describe())
         ));
-        let reached = k >= 2 && level.est.is_some_and(|e| e.iter().all(|&v| v < target));
+        let reached = k >= 2 && level.est.is_some_and(|e| e.values().iter().all(|&v| v < target));
         let est = level.est;
         levels.push(level);
         // The next level's marking, while this level's fields are at hand (not when it is the last).
@@ -290,16 +350,26 @@ fn mark(scene: &Scene, fields: &FieldsOnFace, edges: &[f64], marking: f64) -> Ve
 
 /// The message of a run that stops short of `target`: why, and which level's result is
 /// written with which estimate.
-fn short_of(target: f64, why: &str, level: usize, est: Option<[f64; 2]>) -> String {
+fn short_of(target: f64, why: &str, level: usize, est: Option<Estimate>) -> String {
     format!(
         "accuracy: target {target} not reached: {why}; the result of level {level} is written with its estimated error ({})",
         describe(est)
     )
 }
 
-/// "hc x %, hm y %", or "none: one level" without an estimate.
-fn describe(est: Option<[f64; 2]>) -> String {
-    est.map_or("none: a single level".to_string(), |e| format!("hc {:.2} %, hm {:.2} %", 100.0 * e[0], 100.0 * e[1]))
+/// The estimate, or "none: a single level" without one.
+fn describe(est: Option<Estimate>) -> String {
+    est.map_or("none: a single level".to_string(), |e| e.describe())
+}
+
+/// The friction coefficients fx, fz of a level (every rank holds the whole iterate), or
+/// None without friction.
+fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<[f64; 2]>, String> {
+    let visc = scene.viscosity_law().expect("lubricated scene");
+    let eta = move |p: f64| visc.viscosity_and_derivative(p).0;
+    let Some(fs) = super::lubricated::friction_setup(scene, &eta, fields.mesh.spec.contact) else { return Ok(None) };
+    let f = crate::friction::pass::friction_pass(fields, &fs)?;
+    Ok(Some([f.fx, f.fz]))
 }
 
 /// Writes the result of `done` (the last level solved) with the accuracy report; with a
@@ -345,13 +415,17 @@ fn add_accuracy_to_summary(
             });
             // The first level has no estimate: the key is left out (summary.json holds no null).
             if let Some(e) = l.est {
-                v["estimated_error"] = json!({ "hc": e[0], "hm": e[1] });
+                v["estimated_error"] = e.json();
+            }
+            if let Some([fx, fz]) = l.friction {
+                v["fx"] = json!(fx);
+                v["fz"] = json!(fz);
             }
             v
         }).collect::<Vec<_>>(),
     });
     if let Some(e) = last.est {
-        summary["accuracy"]["estimated_error"] = json!({ "hc": e[0], "hm": e[1] });
+        summary["accuracy"]["estimated_error"] = e.json();
     }
     if let Some(why) = shortfall {
         summary["accuracy"]["not_reached_because"] = json!(why);
@@ -378,5 +452,33 @@ mod tests {
         assert_eq!(estimate(&[1.0]), None);
         // Two values: the change itself.
         assert!((estimate(&[1.0, 1.01]).unwrap() - 0.01 / 1.01).abs() < 1e-15);
+    }
+
+    #[test]
+    fn friction_errors_are_relative_to_the_friction_coefficient_and_join_the_targets() {
+        let level = |hc: f64, f: Option<[f64; 2]>| Level {
+            elastic_unknowns: 0,
+            pressure_unknowns: 0,
+            contact_triangles: 0,
+            min_size: 0.25,
+            newton_iterations: 0,
+            seconds: 0.0,
+            hc,
+            hm: 1.0,
+            pmax: 1.0,
+            friction: f,
+            est: None,
+        };
+        // fz is zero up to round-off (no spin): its change is measured against |f|, not |fz|.
+        let levels = [level(1.0, Some([0.03, 1e-12])), level(1.0, Some([0.0303, 3e-12]))];
+        let e = Estimate::of(&levels).unwrap();
+        let [fx, fz] = e.friction.unwrap();
+        assert!((fx - 0.0003 / 0.0303).abs() < 1e-12 && fz < 1e-9, "{e:?}");
+        assert_eq!(e.values().len(), 4);
+        assert!(e.describe().contains("fx 0.99 %"), "{}", e.describe());
+        // Without friction only hc and hm.
+        let e = Estimate::of(&[level(1.0, None), level(1.02, None)]).unwrap();
+        assert_eq!((e.values().len(), e.friction), (2, None));
+        assert!(Estimate::of(&[level(1.0, None)]).is_none());
     }
 }

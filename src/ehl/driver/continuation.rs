@@ -330,7 +330,7 @@ pub(super) fn newton_with_continuation(
         base.reynolds.penalty = PENALTY_START;
     }
     // 1. Plain Newton from the start at the base problem.
-    let report = if opts.skip_plain {
+    let report = if opts.skip_plain || !policy.plain_first {
         SolveReport {
             converged: false,
             reason: "SKIPPED".into(),
@@ -344,7 +344,9 @@ pub(super) fn newton_with_continuation(
         nw.solve(&base, system, x0)?
     };
     let at_xi = if staged { format!(", xi = {PENALTY_START:e}") } else { String::new() };
-    nw.note(format!("Newton from {label} at L = {target} N{at_xi}: {} ({} iterations)", report.reason, report.iterations));
+    if policy.plain_first {
+        nw.note(format!("Newton from {label} at L = {target} N{at_xi}: {} ({} iterations)", report.reason, report.iterations));
+    }
     nw.iterations = report.iterations;
     let mut last = report;
     // The converged state of the base problem.

@@ -16,6 +16,7 @@ mod problem;
 mod start;
 
 pub use diagnostics::check_jacobian;
+use policy::Attempt;
 pub use policy::{set_newton_defaults, set_newton_linear_solver, Coupling, CONDENSED_PREFIX};
 pub use problem::{lambda_bar, lubricant, velocity_field};
 pub use start::Start;
@@ -137,33 +138,29 @@ impl<'a> EhlSolver<'a> {
         self.solve_from(ctx, scene, start.map_or(Start::Hertz, Start::Previous))
     }
 
-    /// Solves the scene's operating point from `start`; when Newton fails from a start
-    /// other than the Hertz start, the solve starts over from the Hertz start (with its
-    /// automatic continuation). Collective.
-    ///
-    /// On the monolithic coupling a start other than the Hertz start first reuses the LU
-    /// over Newton steps (`Policy::reuses_lu`); if that fails, the same start is solved
-    /// again with an LU at every step before the Hertz start is tried.
+    /// Solves the scene's operating point from `start`: the attempts of
+    /// [`Attempt::ladder`] in order (plain Newton, the monolithic LU reused; from another
+    /// mesh's pressure then the continuation from that pressure), then the Hertz start with
+    /// its automatic continuation. Collective.
     pub fn solve_from(&self, ctx: &Context, scene: &Scene, start: Start) -> Result<EhlSolution, String> {
-        let once = |start: Start, reuse_lu: bool| match &self.comp {
-            None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, reuse_lu),
-            Some(comp) => solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, start),
+        let once = |start: Start, attempt: Attempt| match &self.comp {
+            None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, attempt),
+            Some(comp) => solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, start, attempt),
         };
         if !matches!(start, Start::Hertz) {
-            let tries: &[bool] = if self.comp.is_none() { &[true, false] } else { &[false] };
-            for (k, &reuse_lu) in tries.iter().enumerate() {
-                match once(start, reuse_lu) {
+            let ladder = Attempt::ladder(&start, self.comp.is_none());
+            for (k, attempt) in ladder.iter().enumerate() {
+                match once(start, *attempt) {
                     Ok(s) => return Ok(s),
                     Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
-                    Err(e) if k + 1 < tries.len() => ctx.log(format!(
-                        "Newton from {} with the LU reused over steps failed ({e}); again with an LU at every step",
-                        start.label()
-                    )),
-                    Err(e) => ctx.log(format!("Newton from {} failed ({e}); starting over from the Hertz start", start.label())),
+                    Err(e) => {
+                        let next = ladder.get(k + 1).map_or("the Hertz start", |a| a.describe());
+                        ctx.log(format!("from {}: {} failed ({e}); now {next}", start.label(), attempt.describe()));
+                    }
                 }
             }
         }
-        once(Start::Hertz, false)
+        once(Start::Hertz, Attempt::PLAIN)
     }
 }
 
@@ -189,6 +186,7 @@ fn pressure_nodes(mesh: &Mesh, layout: &Layout) -> Vec<u32> {
 
 /// The condensed path: Newton on (P, H0) with the face compliance `comp`, from the Hertz
 /// start or from a previous state `start` (monolithic layout).
+#[allow(clippy::too_many_arguments)]
 fn solve_condensed(
     ctx: &Context,
     scene: &Scene,
@@ -197,6 +195,7 @@ fn solve_condensed(
     comp: &crate::solid::condense::Compliance,
     half: bool,
     start: Start,
+    attempt: Attempt,
 ) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
@@ -250,8 +249,17 @@ fn solve_condensed(
         cl.n_p,
         if comp.is_rigid() { "sparse" } else { "dense" }
     ));
-    let out =
-        newton_with_continuation(ctx, scene, &mut system, &x0, label, Policy::for_start(&start, false), &j, (lo, hi), cl.local(ctx.rank))?;
+    let out = newton_with_continuation(
+        ctx,
+        scene,
+        &mut system,
+        &x0,
+        label,
+        Policy::for_start(&start, attempt),
+        &j,
+        (lo, hi),
+        cl.local(ctx.rank),
+    )?;
     let solve_s = t1.elapsed().as_secs_f64();
     // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
     let uy = system.uy(&out.x);
@@ -282,7 +290,7 @@ fn solve_monolithic(
     layout: &Layout,
     half: bool,
     start: Start,
-    reuse_lu: bool,
+    attempt: Attempt,
 ) -> Result<EhlSolution, String> {
     let pe = |e: petsc::PetscError| e.to_string();
     let comm = petsc::comm_world();
@@ -341,7 +349,7 @@ fn solve_monolithic(
         &mut system,
         &x0,
         label,
-        Policy::for_start(&start, reuse_lu),
+        Policy::for_start(&start, attempt),
         &j,
         (lo, hi),
         layout.local(ctx.rank),

@@ -76,23 +76,83 @@ pub(super) struct Policy {
     /// continuation after it failed; that run predates the tilt continuation on the
     /// monolithic coupling).
     pub(super) reuses_lu: bool,
+    /// Plain Newton at the scene's problem comes first (the continuation only after it).
+    pub(super) plain_first: bool,
 }
 
 impl Policy {
-    /// How Newton proceeds from `start`; `reuse_lu`: the monolithic coupling may reuse
-    /// its LU over Newton steps (see `Policy::reuses_lu`).
-    pub(super) fn for_start(start: &Start, reuse_lu: bool) -> Policy {
+    /// How Newton proceeds from `start` in the given attempt ([`Attempt`]).
+    pub(super) fn for_start(start: &Start, attempt: Attempt) -> Policy {
+        let hertz = matches!(start, Start::Hertz);
+        let coarse = matches!(start, Start::Pressure { .. });
         Policy {
-            // Only from the Hertz start: another start falls back to the Hertz start instead.
-            continues: matches!(start, Start::Hertz),
+            // From the Hertz start always; from another start only in the attempt that
+            // continues (before it, a failure moves on to the next attempt).
+            continues: hertz || attempt.continues,
             // From the Hertz start and from another mesh's pressure (its cavitation boundary
             // is the coarser mesh's), not from a previous state of the same mesh (a sweep).
             stages_penalty: !matches!(start, Start::Previous(_)),
-            line_search: match start {
-                Start::Pressure { .. } => "l2",
-                _ => "bt",
-            },
-            reuses_lu: reuse_lu && !matches!(start, Start::Hertz),
+            // "l2" for plain Newton from another mesh's pressure; the continuation from it
+            // takes "bt" as from the Hertz start: its milder problems have a thinner film,
+            // so the first steps cross H = 0 at some nodes, and "l2" stops there
+            // (DIVERGED_FUNCTION_DOMAIN, M = 100, L = 20 at alpha/4) where "bt" backtracks.
+            line_search: if coarse && !attempt.continues { "l2" } else { "bt" },
+            reuses_lu: attempt.reuse_lu && !hertz,
+            // The continuation attempt follows plain Newton from the same start, which
+            // failed: it goes straight to the continuation.
+            plain_first: hertz || !attempt.continues,
+        }
+    }
+}
+
+/// Newton iterations of one solve (`-snes_max_it` unless the user gave it). Plain Newton
+/// from a coarser mesh's pressure converges in 6-14 on the adaptive ladders measured, but in
+/// 25-27 on the hard cases' hand-made refinements (docs/hard-cases.md), so it keeps 30.
+pub(super) const MAX_IT: usize = 30;
+
+/// One way of solving from a start: [`super::EhlSolver::solve_from`] tries the attempts of
+/// [`Attempt::ladder`] in order and then the Hertz start.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Attempt {
+    /// The monolithic LU is reused over Newton steps ([`Policy::reuses_lu`]).
+    pub(super) reuse_lu: bool,
+    /// Plain Newton is skipped (it failed in the attempt before) and the continuation
+    /// runs from this start.
+    pub(super) continues: bool,
+}
+
+impl Attempt {
+    /// Exact Newton, no continuation: the Hertz start's first solve.
+    pub(super) const PLAIN: Attempt = Attempt { reuse_lu: false, continues: false };
+
+    /// The attempts from a start other than the Hertz start, in order, on the monolithic
+    /// coupling (`monolithic`) or the condensed one.
+    ///
+    /// - Plain Newton, with the monolithic LU reused over steps (cheapest near the solution).
+    /// - A previous operating point (a sweep) on the monolithic coupling: exact Newton.
+    /// - Another mesh's pressure (a coarser level): the continuation from that pressure
+    ///   (pressure-viscosity first: alpha/2, then alpha). At M = 1000, L = 10 from 0.125 a
+    ///   to 0.0625 a, plain Newton failed with the LU reused (18 iterations), exact (30)
+    ///   and with both step safeguards off (30), and the continuation from the coarse
+    ///   pressure converged in 9 + 11 + 7 iterations; the Hertz start on a fine level
+    ///   redoes the whole ramp from far away and stalls short of the scene's alpha
+    ///   (M = 100, L = 20).
+    pub(super) fn ladder(start: &Start, monolithic: bool) -> Vec<Attempt> {
+        let first = Attempt { reuse_lu: monolithic, ..Attempt::PLAIN };
+        match start {
+            Start::Hertz => vec![Attempt::PLAIN],
+            Start::Previous(_) if monolithic => vec![first, Attempt::PLAIN],
+            Start::Previous(_) => vec![first],
+            Start::Pressure { .. } => vec![first, Attempt { continues: true, ..Attempt::PLAIN }],
+        }
+    }
+
+    /// What the attempt is, for the log.
+    pub(super) fn describe(&self) -> &'static str {
+        match (self.reuse_lu, self.continues) {
+            (true, _) => "plain Newton with the LU reused over steps",
+            (false, false) => "exact plain Newton",
+            (false, true) => "the continuation",
         }
     }
 }
@@ -106,7 +166,7 @@ pub fn set_newton_defaults() -> petsc::Result<()> {
     use petsc::options::set_default;
     set_default("-snes_type", "newtonls")?;
     set_default("-snes_linesearch_type", "bt")?;
-    set_default("-snes_max_it", "30")?;
+    set_default("-snes_max_it", &MAX_IT.to_string())?;
     set_default("-snes_rtol", "1e-10")?;
     set_default("-snes_atol", "1e-11")?;
     // A tiny step is not convergence: only the residual norm decides.
@@ -149,6 +209,30 @@ pub fn set_newton_linear_solver(reuse_lu: bool) -> petsc::Result<()> {
 
 #[cfg(test)]
 mod tests {
+    use super::{Attempt, Policy, Start};
+
+    #[test]
+    fn another_meshs_pressure_continues_from_itself_after_a_short_plain_newton() {
+        let p = |_: f64, _: f64| 0.0;
+        let coarse = Start::Pressure { p: &p, hc: 0.5, label: "level 0" };
+        for monolithic in [true, false] {
+            let ladder = Attempt::ladder(&coarse, monolithic);
+            assert_eq!(ladder.len(), 2);
+            assert_eq!(ladder[0].reuse_lu, monolithic);
+            let (plain, cont) = (Policy::for_start(&coarse, ladder[0]), Policy::for_start(&coarse, ladder[1]));
+            assert!(plain.plain_first && !plain.continues);
+            assert!(!cont.plain_first && cont.continues && !cont.reuses_lu);
+            assert_eq!((plain.line_search, cont.line_search), ("l2", "bt"));
+        }
+        // A sweep's previous point: the LU reuse on the monolithic coupling, then exact Newton.
+        let x = [0.0; 4];
+        assert_eq!(Attempt::ladder(&Start::Previous(&x), true).len(), 2);
+        assert_eq!(Attempt::ladder(&Start::Previous(&x), false), vec![Attempt::PLAIN]);
+        assert!(!Policy::for_start(&Start::Previous(&x), Attempt::PLAIN).continues);
+        let hertz = Policy::for_start(&Start::Hertz, Attempt::PLAIN);
+        assert!(hertz.continues && hertz.plain_first && !hertz.reuses_lu);
+    }
+
     #[test]
     fn auto_coupling_switches_to_monolithic_above_the_measured_crossover() {
         use crate::case::{Coupling, AUTO_MONOLITHIC_ABOVE as N, AUTO_MONOLITHIC_ABOVE_SWEEP as NS};
