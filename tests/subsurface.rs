@@ -1,5 +1,5 @@
-//! Subsurface stresses of the dry Hertz scene (cases/dry-hertz.toml, default mesh,
-//! `output.subsurface = true`) against closed-form half-space solutions: Huber's field on
+//! Subsurface stresses of the dry Hertz scene (cases/dry-hertz.toml, no mesh keys,
+//! `output.subsurface = true`: the default mesh with the subsurface core box) against closed-form half-space solutions: Huber's field on
 //! the axis of a frictionless contact, and Hamilton's (1983) sliding contact with a
 //! tangential traction q = mu p. Tolerances are justified in docs/subsurface.md (the
 //! measured errors on this mesh and their convergence under refinement).
@@ -28,10 +28,11 @@ fn run_dry(name: &str, extra: &[&str]) -> (std::path::PathBuf, serde_json::Value
     (dir, s)
 }
 
-/// Huber (Johnson Eq. 3.45) along the axis: sigma_y (the normal stress, Johnson's sigma_z)
-/// and sigma_x = sigma_z (Johnson's sigma_r) within 1.5 % of p_H below 0.1 a and 2.5 % at
-/// the surface point; the largest shear stress (Tresca / 2) within 1 % of Huber's maximum
-/// (0.310 p_H) and its depth within 0.03 a of Huber's (0.481 a).
+/// Huber (Johnson Eq. 3.45) along the axis from the surface to 2 a: sigma_y (the normal
+/// stress, Johnson's sigma_z) and sigma_x = sigma_z (Johnson's sigma_r) within 1 % of p_H,
+/// surface point included (measured: at most 0.65 %, at the surface 0.27 %); the largest
+/// shear stress (Tresca / 2) within 1 % of Huber's maximum (0.310 p_H; measured -0.01 %) and
+/// its depth within 1 % of Huber's 0.481 a (measured 0.484 a).
 #[test]
 fn dry_hertz_subsurface_matches_huber() {
     let (dir, s) = run_dry("subsurface-huber", &[]);
@@ -45,7 +46,7 @@ fn dry_hertz_subsurface_matches_huber() {
             break;
         }
         let (sz, sr) = huber_axis(d, NU);
-        let tol = if d < 0.1 { 0.025 } else { 0.015 };
+        let tol = 0.01;
         let (sxx, syy, szz) = (v[1] / ph, v[2] / ph, v[3] / ph);
         assert!((syy - sz).abs() < tol, "depth {d:.3} a: sigma_y = {syy:.4} p_H, Huber {sz:.4}");
         assert!(
@@ -68,7 +69,7 @@ fn dry_hertz_subsurface_matches_huber() {
     let tau = 0.5 * num(&s, "subsurface.tresca_max_pa") / ph;
     let depth = num(&s, "subsurface.tresca_max_depth_m") / a;
     assert!((tau / tmax - 1.0).abs() < 0.01, "max shear {tau:.4} p_H vs Huber {tmax:.4} p_H");
-    assert!((depth - zmax).abs() < 0.03, "max shear at depth {depth:.3} a vs Huber {zmax:.3} a");
+    assert!((depth / zmax - 1.0).abs() < 0.01, "max shear at depth {depth:.3} a vs Huber {zmax:.3} a");
     // The maximum lies on the axis (the load is axisymmetric).
     let r = num(&s, "subsurface.tresca_max_x_m").hypot(num(&s, "subsurface.tresca_max_z_m")) / a;
     assert!(r < 0.1, "max shear {r:.3} a off the axis");
@@ -85,9 +86,12 @@ fn dry_hertz_subsurface_matches_huber() {
     assert!(num(&s, "subsurface.solve.seconds") < 0.5 * num(&s, "timing.solve_s"));
 }
 
-/// Hamilton (1983) with q = mu p in +x: the von Mises maximum on the plane of symmetry
-/// (value within 2 %, position within 0.05 a in x and in depth; the solver's frame maps
-/// Hamilton's (x, y, z) to (x, z, -y)).
+/// Hamilton (1983) with q = mu p in +x: the von Mises maximum on the plane of symmetry,
+/// value within 0.5 % (measured: 0.03 % for mu = 0.1 and 0.3, 0.1 % on a mesh twice as
+/// fine) and position within 0.02 a of Hamilton's (measured 0.004 a and 0.012 a; the
+/// maximum is flat, so its position scatters by 0.01-0.03 a between meshes of 0.125 a and
+/// finer, and the plain default mesh was 0.04 a off). The solver's frame maps Hamilton's
+/// (x, y, z) to (x, z, -y).
 fn check_hamilton(mu: f64) {
     let m = mu.to_string();
     let (_, s) = run_dry(
@@ -110,11 +114,8 @@ fn check_hamilton(mu: f64) {
     eprintln!(
         "mu = {mu}: von Mises max {v:.4} p_H at x = {x:.4} a, depth {d:.4} a; Hamilton {vref:.4} at x = {xref:.4} a, depth {zref:.4} a"
     );
-    assert!((v / vref - 1.0).abs() < 0.02, "mu = {mu}: von Mises max {v:.4} p_H vs Hamilton {vref:.4}");
-    assert!(
-        (x - xref).abs() < 0.05 && (d - zref).abs() < 0.05,
-        "mu = {mu}: maximum at ({x:.3}, depth {d:.3}) a vs Hamilton ({xref:.3}, {zref:.3}) a"
-    );
+    assert!((v / vref - 1.0).abs() < 0.005, "mu = {mu}: von Mises max {v:.4} p_H vs Hamilton {vref:.4}");
+    assert!((x - xref).hypot(d - zref) < 0.02, "mu = {mu}: maximum at ({x:.3}, depth {d:.3}) a vs Hamilton ({xref:.3}, {zref:.3}) a");
     // Over the whole region the maximum is the same (the plane of symmetry holds it).
     let v3 = num(&s, "subsurface.von_mises_max_pa") / ph;
     assert!((v3 / v - 1.0).abs() < 0.01, "3D maximum {v3:.4} vs plane {v:.4}");

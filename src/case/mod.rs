@@ -135,6 +135,14 @@ pub fn parse_scene_with(text: &str, default_name: &str, overrides: &[String]) ->
             scene.reynolds.x_min = schema::ADAPTIVE_X_MIN;
         }
     }
+    // A scene that asks for the subsurface stresses without making its mesh by hand gets
+    // the core box below the contact they need (docs/subsurface.md); a scene that does not
+    // ask pays nothing.
+    if !hand_mesh && scene.output.subsurface {
+        scene.mesh.core_size = schema::SUBSURFACE_CORE_SIZE;
+        scene.mesh.core_half_width = schema::SUBSURFACE_CORE_HALF_WIDTH;
+        scene.mesh.core_depth = schema::SUBSURFACE_CORE_DEPTH;
+    }
     if scene.name.is_empty() {
         if default_name.trim().is_empty() {
             return Err(SceneErrorKind::MissingField {

@@ -577,3 +577,29 @@ fn a_scene_without_mesh_keys_is_refined_with_the_adaptive_defaults() {
     let s = parse_scene_with(&minimal, "m", &["accuracy.target=0".into()]).unwrap();
     assert_eq!((s.mesh.growth, s.reynolds.x_min), (0.5, -3.0));
 }
+
+#[test]
+fn a_scene_asking_for_subsurface_stresses_without_mesh_keys_gets_the_core_box() {
+    use crate::case::schema::{SUBSURFACE_CORE_DEPTH, SUBSURFACE_CORE_HALF_WIDTH, SUBSURFACE_CORE_SIZE};
+    let core = |s: &Scene| (s.mesh.core_size, s.mesh.core_half_width, s.mesh.core_depth);
+    let subsurface = ["output.subsurface=true".to_string()];
+    let boxed = (SUBSURFACE_CORE_SIZE, SUBSURFACE_CORE_HALF_WIDTH, SUBSURFACE_CORE_DEPTH);
+    let plain = (0.0, 1.25, 0.0);
+    // Asked for, no [mesh]: the core box; the rest of the mesh keeps its defaults.
+    let s = parse_scene_with(DRY_HERTZ, "t", &subsurface).unwrap();
+    assert_eq!(core(&s), boxed);
+    assert_eq!((s.mesh.contact_size, s.mesh.growth), (0.25, 0.5));
+    assert!(!s.warnings().iter().any(|w| w.contains("mesh.")), "{:?}", s.warnings());
+    // Not asked for: nothing changes.
+    assert_eq!(core(&parse_scene(DRY_HERTZ, "t").unwrap()), plain);
+    // A [mesh] key (in the file or with --set): the scene's own mesh, no core box.
+    let own = parse_scene_with(DRY_HERTZ, "t", &[subsurface[0].clone(), "mesh.contact_size=0.25".into()]).unwrap();
+    assert_eq!(core(&own), plain);
+    let own = parse_scene_with(DRY_HERTZ, "t", &[subsurface[0].clone(), "mesh.core_size=0.0625".into()]).unwrap();
+    assert_eq!(core(&own), (0.0625, 1.25, 0.0));
+    // A lubricated scene refined to its accuracy target gets it as well.
+    let minimal = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/cases/examples/minimal.toml")).unwrap();
+    let s = parse_scene_with(&minimal, "m", &subsurface).unwrap();
+    assert_eq!(core(&s), boxed);
+    assert!(s.accuracy.target > 0.0);
+}

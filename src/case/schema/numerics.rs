@@ -238,21 +238,21 @@ pub const MESH_FIELDS: &[Field] = &[
         "element size in the core square around the Hertz contact (rounded down to 16/2^k; 0: no core)",
         "a",
         Kind::Number(Range::Closed(0.0, 16.0)),
-        Presence::Default("0")
+        Presence::Default("0; 0.125 with output.subsurface without a [mesh] table")
     ),
     f!(
         "core_half_width",
         "half width of the core square |X|, |Z| <= w",
         "a",
         Kind::Number(Range::Closed(0.25, 8.0)),
-        Presence::Default("1.25")
+        Presence::Default("1.25; 1 with output.subsurface without a [mesh] table")
     ),
     f!(
         "core_depth",
         "depth of the core box below the face (0: the core square on the face only; > 0 refines the solid below the contact for output.subsurface)",
         "a",
         Kind::Number(Range::Closed(0.0, 8.0)),
-        Presence::Default("0")
+        Presence::Default("0; 0.25 with output.subsurface without a [mesh] table")
     ),
     f!(
         "ring_size",
@@ -313,7 +313,8 @@ pub struct OutputSettings {
     /// shear-stress profile (`shear_profile.csv`); default 0 (the centre line).
     pub shear_profile_z: f64,
     /// Recover the stresses inside the disc below the contact (subsurface.vtu, section
-    /// maps, `subsurface` in summary.json); default false.
+    /// maps, `subsurface` in summary.json); default false. A scene without a `[mesh]` table
+    /// that sets it also gets the core box below the contact ([`super::SUBSURFACE_CORE_SIZE`]).
     pub subsurface: bool,
     /// "spr" | "average"; default "spr".
     pub subsurface_recovery: StressRecovery,
@@ -347,7 +348,7 @@ pub const OUTPUT_FIELDS: &[Field] = &[
     ),
     f!(
         "subsurface",
-        "recover the stresses in the disc below the contact (one extra elastic solve)",
+        "recover the stresses in the disc below the contact (one extra elastic solve); without a [mesh] table the mesh gets the core box the stresses need (mesh.core_size 0.125, core_half_width 1, core_depth 0.25)",
         "",
         Kind::Bool,
         Presence::Default("false")
