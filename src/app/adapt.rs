@@ -245,9 +245,15 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             (Some(prev), _) => {
                 let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
                 let p = |x: f64, z: f64| pf.at(x, z).map_or(0.0, |v| v.0);
+                // A level after one that plain Newton could not solve from its own coarser
+                // level goes to the continuation at once (level 0 is not a guide: its start
+                // is the Hertz pressure, not a coarser level's).
+                let plain = !(k >= 2 && prev.sol.continued);
                 let label = format!("level {}'s pressure ({} contact triangles)", k - 1, prev.setup.mesh.contact_tris.len());
-                let solved =
-                    collective::agree(&ctx.world, solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc: prev.hc, label: &label }));
+                let solved = collective::agree(
+                    &ctx.world,
+                    solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc: prev.hc, label: &label, plain }),
+                );
                 match solved {
                     Ok(sol) => sol,
                     // A level that does not converge leaves the last converged one as the

@@ -25,6 +25,8 @@ pub(super) struct NewtonOutcome {
     pub(super) report: SolveReport,
     pub(super) newton_total: usize,
     pub(super) steps: Vec<String>,
+    /// The state came from a continuation (plain Newton from the start did not converge).
+    pub(super) continued: bool,
 }
 
 /// A scene parameter a continuation varies, with the scene's value: at t = 1 the scene
@@ -351,6 +353,7 @@ pub(super) fn newton_with_continuation(
     let mut last = report;
     // The converged state of the base problem.
     let mut state: Option<Vec<f64>> = if last.converged { Some(nw.solution()?) } else { None };
+    let continued = state.is_none();
     // 2. If it failed: the continuations, each from a milder problem back to the base one.
     if state.is_none() && policy.continues {
         for h in homotopies(scene) {
@@ -403,7 +406,7 @@ pub(super) fn newton_with_continuation(
             nw.steps.join("; ")
         ));
     };
-    Ok(NewtonOutcome { x: xs, report: last, newton_total: nw.iterations, steps: nw.steps })
+    Ok(NewtonOutcome { x: xs, report: last, newton_total: nw.iterations, steps: nw.steps, continued })
 }
 
 #[cfg(test)]

@@ -48,6 +48,8 @@ pub struct EhlSolution {
     pub solve_s: f64,
     /// The coupling solved (see [`EhlSolver::coupling`]).
     pub coupling: Coupling,
+    /// Plain Newton from the start failed and a continuation found the state.
+    pub continued: bool,
 }
 
 /// The lubricated solver of one mesh: the parts that do not depend on the operating
@@ -275,7 +277,16 @@ fn solve_condensed(
     }
     x[layout.h0 as usize] = out.x[cl.h0()];
     let coupling = if comp.is_rigid() { Coupling::Rigid } else { Coupling::Condensed };
-    Ok(EhlSolution { x, report: out.report, newton_total: out.newton_total, steps: out.steps, assembly_s, solve_s, coupling })
+    Ok(EhlSolution {
+        x,
+        report: out.report,
+        newton_total: out.newton_total,
+        steps: out.steps,
+        assembly_s,
+        solve_s,
+        coupling,
+        continued: out.continued,
+    })
 }
 
 /// The monolithic path: U, P and H0 in one sparse system, from the Hertz start or from a
@@ -363,5 +374,6 @@ fn solve_monolithic(
         assembly_s,
         solve_s,
         coupling: Coupling::Monolithic,
+        continued: out.continued,
     })
 }

@@ -137,13 +137,18 @@ impl Attempt {
     ///   pressure converged in 9 + 11 + 7 iterations; the Hertz start on a fine level
     ///   redoes the whole ramp from far away and stalls short of the scene's alpha
     ///   (M = 100, L = 20).
+    /// - A coarser level that itself needed the continuation (`plain: false`): the
+    ///   continuation at once. Plain Newton failed on every level after the first at
+    ///   M = 1000, L = 10 and M = 100, L = 20 (levels 1-3), and on the 449k-unknown level it
+    ///   cost 540 s before the continuation started.
     pub(super) fn ladder(start: &Start, monolithic: bool) -> Vec<Attempt> {
         let first = Attempt { reuse_lu: monolithic, ..Attempt::PLAIN };
         match start {
             Start::Hertz => vec![Attempt::PLAIN],
             Start::Previous(_) if monolithic => vec![first, Attempt::PLAIN],
             Start::Previous(_) => vec![first],
-            Start::Pressure { .. } => vec![first, Attempt { continues: true, ..Attempt::PLAIN }],
+            Start::Pressure { plain: true, .. } => vec![first, Attempt { continues: true, ..Attempt::PLAIN }],
+            Start::Pressure { plain: false, .. } => vec![Attempt { continues: true, ..Attempt::PLAIN }],
         }
     }
 
@@ -214,7 +219,7 @@ mod tests {
     #[test]
     fn another_meshs_pressure_continues_from_itself_after_a_short_plain_newton() {
         let p = |_: f64, _: f64| 0.0;
-        let coarse = Start::Pressure { p: &p, hc: 0.5, label: "level 0" };
+        let coarse = Start::Pressure { p: &p, hc: 0.5, label: "level 0", plain: true };
         for monolithic in [true, false] {
             let ladder = Attempt::ladder(&coarse, monolithic);
             assert_eq!(ladder.len(), 2);
@@ -224,6 +229,9 @@ mod tests {
             assert!(!cont.plain_first && cont.continues && !cont.reuses_lu);
             assert_eq!((plain.line_search, cont.line_search), ("l2", "bt"));
         }
+        // After a coarser level that needed the continuation: the continuation at once.
+        let hard = Start::Pressure { p: &p, hc: 0.5, label: "level 1", plain: false };
+        assert_eq!(Attempt::ladder(&hard, true), vec![Attempt { reuse_lu: false, continues: true }]);
         // A sweep's previous point: the LU reuse on the monolithic coupling, then exact Newton.
         let x = [0.0; 4];
         assert_eq!(Attempt::ladder(&Start::Previous(&x), true).len(), 2);

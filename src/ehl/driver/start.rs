@@ -22,8 +22,10 @@ pub enum Start<'s> {
     Previous(&'s [f64]),
     /// A pressure field P(X, Z) from another mesh (mesh sequencing: a coarser level's
     /// converged solution, interpolated), its deflection, and H0 so that the central film
-    /// is `hc` (dimensionless). `label` names it in the log.
-    Pressure { p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str },
+    /// is `hc` (dimensionless). `label` names it in the log. With `plain` false plain
+    /// Newton is skipped and the continuation runs from it at once (the coarser level
+    /// itself needed the continuation: see [`super::policy::Attempt::ladder`]).
+    Pressure { p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str, plain: bool },
 }
 
 impl<'s> Start<'s> {
