@@ -84,3 +84,21 @@ fn isoviscous_rigid_regime_without_a_3d_mesh() {
     // Rigid: the minimum film is at the centre, h_min = h_c = h0.
     assert!((num(&s, "film.hc_m") - hm).abs() < 1e-3 * hm);
 }
+
+/// A friction coefficient above 1 is not a result a lubricated contact can have: the
+/// Newtonian law with Barus viscosity at 1 GPa (exp(23e-9 x 1.1e9) = 1e11 times eta0 in
+/// the contact) gives a mean shear stress eta(p) du / h of order 1e14 Pa, three orders above
+/// the pressure. The run says so next to the number (the model computed what was asked; the
+/// default scene, with Ree-Eyring, prints no warning: tests/default_scene.rs).
+#[test]
+fn an_absurd_newtonian_friction_coefficient_is_reported_with_a_warning() {
+    let dir = scratch("effects-newtonian");
+    let scene = repo().join("cases/examples/barus-newtonian.toml");
+    let out_dir = dir.join("out");
+    let out = mpirun(1, &[scene.to_str().unwrap(), "--output", out_dir.to_str().unwrap(), "--set", "accuracy.target=0"]);
+    let t = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{t}");
+    let fx = num(&summary(&out_dir), "friction.fx");
+    assert!(fx > 1.0, "fx = {fx}");
+    assert!(t.contains("warning: the friction coefficient") && t.contains("ree-eyring"), "{t}");
+}

@@ -253,6 +253,17 @@ pub fn post_point(
                 "friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s)",
                 scene.effects.friction, f.fx, f.fz, f.fx_n, f.fz_n, f.tau_max, f.seconds
             ));
+            // A lubricated contact's friction coefficient is of order 0.01-0.1; above 1 the
+            // Newtonian law has carried exp(alpha p) viscosities into shear stresses no
+            // lubricant sustains (the limiting shear stress is what Ree-Eyring adds).
+            if f.fx.hypot(f.fz) > 1.0 {
+                ctx.log(format!(
+                    "warning: the friction coefficient sqrt(fx^2 + fz^2) = {:.3e} is above 1: with effects.friction = \"{}\" the shear stress reaches {:.3e} Pa, far above any lubricant's limiting shear stress; effects.friction = \"ree-eyring\" bounds it",
+                    f.fx.hypot(f.fz),
+                    scene.effects.friction,
+                    f.tau_max
+                ));
+            }
             res.fx = Some(f.fx);
             res.fz = Some(f.fz);
             Some(f)
