@@ -153,6 +153,9 @@ struct Newton<'a> {
     steps: Vec<String>,
     /// Newton iterations over the path.
     iterations: usize,
+    /// A continuation step stopped at the film's domain is solved again with the "bt"
+    /// line search ([`Policy::bt_after_domain_error`]).
+    bt_after_domain: bool,
 }
 
 impl Newton<'_> {
@@ -203,7 +206,22 @@ impl Newton<'_> {
         if p.kinematic() {
             system.set_velocity(velocity_field(&sc));
         }
-        let r = self.solve(&sc, system, start)?;
+        let mut r = self.solve(&sc, system, start)?;
+        if self.bt_after_domain && r.reason.starts_with("DIVERGED_FUNCTION_DOMAIN") {
+            self.iterations += r.iterations;
+            self.note(format!(
+                "{} continuation: {what}{}: {} ({} iterations); again with the bt line search",
+                p.name(),
+                p.show(t),
+                r.reason,
+                r.iterations
+            ));
+            let pe = |e: petsc::PetscError| e.to_string();
+            petsc::options::set_ours("-snes_linesearch_type", "bt").map_err(pe)?;
+            let again = self.solve(&sc, system, start);
+            petsc::options::set_ours("-snes_linesearch_type", "l2").map_err(pe)?;
+            r = again?;
+        }
         self.iterations += r.iterations;
         self.note(format!("{} continuation: {what}{}: {} ({} iterations)", p.name(), p.show(t), r.reason, r.iterations));
         let xs = if r.converged { Some(self.solution()?) } else { None };
@@ -315,6 +333,7 @@ pub(super) fn newton_with_continuation(
         collapse: None,
         steps: Vec::new(),
         iterations: 0,
+        bt_after_domain: policy.bt_after_domain_error(),
     };
     // The problem solved first. A stiff cavitation penalty (xi > 1e3) is reached last, from
     // the solution at xi = 1e3: on fine rings Newton crawls at xi = 1e4 from the Hertz start

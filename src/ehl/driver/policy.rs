@@ -81,6 +81,14 @@ pub(super) struct Policy {
 }
 
 impl Policy {
+    /// A continuation step with the "l2" line search that stops at the film's domain
+    /// (DIVERGED_FUNCTION_DOMAIN: a milder problem's film is thinner, the first step
+    /// crosses H = 0 at some nodes, and "l2" does not backtrack out of the domain) is
+    /// solved again with "bt", which does (M = 100, L = 20, 0.0625 a, at alpha/4).
+    pub(super) fn bt_after_domain_error(&self) -> bool {
+        self.continues && self.line_search == "l2"
+    }
+
     /// How Newton proceeds from `start` in the given attempt ([`Attempt`]).
     pub(super) fn for_start(start: &Start, attempt: Attempt) -> Policy {
         let hertz = matches!(start, Start::Hertz);
@@ -92,11 +100,11 @@ impl Policy {
             // From the Hertz start and from another mesh's pressure (its cavitation boundary
             // is the coarser mesh's), not from a previous state of the same mesh (a sweep).
             stages_penalty: !matches!(start, Start::Previous(_)),
-            // "l2" for plain Newton from another mesh's pressure; the continuation from it
-            // takes "bt" as from the Hertz start: its milder problems have a thinner film,
-            // so the first steps cross H = 0 at some nodes, and "l2" stops there
-            // (DIVERGED_FUNCTION_DOMAIN, M = 100, L = 20 at alpha/4) where "bt" backtracks.
-            line_search: if coarse && !attempt.continues { "l2" } else { "bt" },
+            // "l2" from another mesh's pressure, in the continuation from it too: on the
+            // alpha ramp of M = 100, L = 20 (0.125 a) "l2" converged where "bt" stalled at
+            // 62.6 of 68.3 GPa^-1. A continuation step that "l2" stops at the film's domain
+            // is solved again with "bt" ([`Policy::bt_after_domain_error`]).
+            line_search: if coarse { "l2" } else { "bt" },
             reuses_lu: attempt.reuse_lu && !hertz,
             // The continuation attempt follows plain Newton from the same start, which
             // failed: it goes straight to the continuation.
@@ -227,7 +235,8 @@ mod tests {
             let (plain, cont) = (Policy::for_start(&coarse, ladder[0]), Policy::for_start(&coarse, ladder[1]));
             assert!(plain.plain_first && !plain.continues);
             assert!(!cont.plain_first && cont.continues && !cont.reuses_lu);
-            assert_eq!((plain.line_search, cont.line_search), ("l2", "bt"));
+            assert_eq!((plain.line_search, cont.line_search), ("l2", "l2"));
+            assert!(cont.bt_after_domain_error() && !plain.bt_after_domain_error());
         }
         // After a coarser level that needed the continuation: the continuation at once.
         let hard = Start::Pressure { p: &p, hc: 0.5, label: "level 1", plain: false };
