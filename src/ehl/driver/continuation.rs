@@ -176,6 +176,18 @@ impl Newton<'_> {
         system.take_collapse();
         self.collapse = None;
         let mut r = self.snes.solve(system, &self.x, self.j).map_err(pe)?;
+        if r.reason_code == petsc::ffi::SNESConvergedReason_SNES_DIVERGED_LINEAR_SOLVE {
+            // A failed factorisation leaves the solver failing every later solve at its
+            // first step (M = 100, L = 20 at 0.0625 a: nine continuation steps in a row
+            // with DIVERGED_LINEAR_SOLVE after 0 iterations): a fresh SNES, KSP and LU,
+            // and the same solve once more.
+            self.note(format!("Newton: {} after {} iterations; again with a new linear solver", r.reason, r.iterations));
+            self.iterations += r.iterations;
+            self.snes = Snes::new(petsc::comm_world(), "").map_err(pe)?;
+            self.x.set_local_values(&start[lo..hi]).map_err(pe)?;
+            system.take_collapse();
+            r = self.snes.solve(system, &self.x, self.j).map_err(pe)?;
+        }
         if let (false, Some(c)) = (r.converged, system.take_collapse()) {
             r.reason = format!("{}: film closed at ({:.3}, {:.3})a", r.reason, c[0], c[1]);
             self.collapse = Some(Collapse { at: c, pole: sc.spin_pole_over_a() });
