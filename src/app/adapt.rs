@@ -277,7 +277,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
         let edges = longest_edges(&setup.mesh);
         let min_size = edges.iter().cloned().fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
-        let mut level = Level {
+        let level = Level {
             elastic_unknowns: n_u,
             pressure_unknowns: n_p,
             contact_triangles: setup.mesh.contact_tris.len(),
@@ -290,9 +290,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             friction: level_friction(scene, &fields)?,
             est: None,
         };
-        levels.push(level.clone());
-        level.est = Estimate::of(&levels);
-        levels.pop();
+        levels.push(level);
+        let est = Estimate::of(&levels);
+        let level = levels.last_mut().expect("the level just pushed");
+        level.est = est;
         ctx.log(format!(
             "accuracy: level {k}: {} contact triangles (smallest {:.4} a), {} unknowns, {} Newton its, {:.1} s: hc = {:.5e} m, hm = {:.5e} m, pmax = {:.4e} Pa{}; estimated error {}",
             level.contact_triangles,
@@ -306,9 +307,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             level.friction.map_or(String::new(), |f| format!(", fx = {:.5e}, fz = {:.5e}", f[0], f[1])),
             level.est.map_or("- (first level)".to_string(), |e| e.describe())
         ));
-        let reached = k >= 2 && level.est.is_some_and(|e| e.values().iter().all(|&v| v < target));
-        let est = level.est;
-        levels.push(level);
+        let reached = k >= 2 && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
         // The next level's marking, while this level's fields are at hand (not when it is the last).
         let marked = (!reached && k < max_levels).then(|| mark(scene, &fields, &edges, acc.marking));
         let condensation_s = solver.condensation_s;
