@@ -1,6 +1,7 @@
 //! PETSc through our own bindgen FFI: raw bindings ([`ffi`]) and a safe RAII layer.
 //! No physics lives here.
 pub mod error;
+pub mod factor;
 pub mod ffi;
 pub mod ksp;
 pub mod matrix;

@@ -38,6 +38,11 @@ pub fn set_default(name: &str, value: &str) -> Result<()> {
     set_value(name, value)
 }
 
+/// True when the user gave `name` (on the command line or in the options file), not our code.
+pub fn user_set(name: &str) -> Result<bool> {
+    Ok(has(name)? && !OURS.lock().unwrap_or_else(|e| e.into_inner()).contains(name))
+}
+
 /// Sets `name value` unless the user gave `name`; a value our own code set earlier is
 /// replaced. For defaults that depend on what is being solved, when one process solves
 /// several systems (a convergence study switching from the condensed to the monolithic

@@ -213,6 +213,13 @@ impl Snes {
         })
     }
 
+    /// Why the last linear solve failed (after a DIVERGED_LINEAR_SOLVE).
+    pub fn linear_failure(&self) -> Result<super::factor::LinearFailure> {
+        let mut ksp: ffi::KSP = std::ptr::null_mut();
+        pcall!(ffi::SNESGetKSP(self.raw, &mut ksp))?;
+        super::factor::last_failure(ksp)
+    }
+
     /// Raw handle for FFI calls.
     pub fn raw(&self) -> ffi::SNES {
         self.raw

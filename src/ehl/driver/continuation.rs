@@ -158,6 +158,22 @@ struct Newton<'a> {
     bt_after_domain: bool,
 }
 
+/// After a MUMPS failure for want of workspace, sets `-mat_mumps_icntl_14` (percentage added
+/// to the analysis's estimate) to four times its value for the factorisations that follow,
+/// unless the user chose it; says what it did, for the log.
+fn more_mumps_workspace(why: &petsc::factor::LinearFailure) -> petsc::Result<String> {
+    const KEY: &str = "-mat_mumps_icntl_14";
+    let (true, Some(now)) = (why.mumps_workspace_too_small(), why.mumps_icntl14) else {
+        return Ok(String::new());
+    };
+    if petsc::options::user_set(KEY)? {
+        return Ok(format!(" (your {KEY} {now} kept)"));
+    }
+    let more = (4 * now).max(80);
+    petsc::options::set_ours(KEY, &more.to_string())?;
+    Ok(format!(" and MUMPS workspace {KEY} {more}"))
+}
+
 impl Newton<'_> {
     fn note(&mut self, s: String) {
         self.ctx.log(&s);
@@ -180,8 +196,12 @@ impl Newton<'_> {
             // A failed factorisation leaves the solver failing every later solve at its
             // first step (M = 100, L = 20 at 0.0625 a: nine continuation steps in a row
             // with DIVERGED_LINEAR_SOLVE after 0 iterations): a fresh SNES, KSP and LU,
-            // and the same solve once more.
-            self.note(format!("Newton: {} after {} iterations; again with a new linear solver", r.reason, r.iterations));
+            // and the same solve once more. When MUMPS's analysis underestimated a
+            // workspace (delayed pivots of the exp(alpha p) rows), a fresh LU with the
+            // same estimate fails again: the new one gets a larger ICNTL(14).
+            let why = self.snes.linear_failure().map_err(pe)?;
+            let more = more_mumps_workspace(&why).map_err(pe)?;
+            self.note(format!("Newton: {} after {} iterations ({why}); again with a new linear solver{more}", r.reason, r.iterations));
             self.iterations += r.iterations;
             self.snes = Snes::new(petsc::comm_world(), "").map_err(pe)?;
             self.x.set_local_values(&start[lo..hi]).map_err(pe)?;
