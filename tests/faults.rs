@@ -156,3 +156,19 @@ fn regression_runner_catches_a_perturbed_reference() {
     assert_eq!(code, Some(1), "a reference moved by 1e-4 must fail:\n{text}");
     assert!(text.contains("| film.hc_m |") && text.contains("DRIFT") && text.contains("FAILED"), "{text}");
 }
+
+/// A Jacobian that MUMPS cannot factorise for want of memory (here the limit
+/// `-mat_mumps_icntl_23 1`, one megabyte) ends the run at once, naming MUMPS's INFOG(1),
+/// with exit 1 and no result: no milder continuation problem has a smaller factorisation,
+/// so retrying them would only repeat the failure.
+#[test]
+fn a_factorisation_out_of_memory_ends_the_run_at_once_naming_the_mumps_error() {
+    let out = scratch("mumps-memory").join("out");
+    let (o, scene) = (out.to_str().unwrap(), repo().join("cases/default.toml"));
+    let r = mpirun(2, &[scene.to_str().unwrap(), "--set", "reynolds.coupling=monolithic", "--output", o, "-mat_mumps_icntl_23", "1"]);
+    let t = text(&r);
+    assert_eq!(r.status.code(), Some(1), "{t}");
+    assert!(t.contains("cannot factorise the Jacobian") && t.contains("INFOG(1) = -19") && t.contains("ICNTL(23)"), "{t}");
+    assert!(!t.contains("continuation:"), "no continuation after a memory failure:\n{t}");
+    assert_no_results(&out);
+}

@@ -51,6 +51,12 @@ pub fn mumps_workspace_code(infog1: i64) -> bool {
     matches!(infog1, -8 | -9 | -11 | -12 | -14 | -15 | -17 | -20)
 }
 
+/// MUMPS error codes that mean the memory itself ran out: -13 (an allocation failed) and -19
+/// (the limit ICNTL(23)). No other matrix of the same pattern factorises either.
+pub fn mumps_memory_code(infog1: i64) -> bool {
+    matches!(infog1, -13 | -19)
+}
+
 /// What a MUMPS INFOG(1) code means (MUMPS 5.5 user guide, section "Error diagnostics").
 pub fn mumps_meaning(infog1: i64) -> &'static str {
     match infog1 {
@@ -68,7 +74,7 @@ pub fn mumps_meaning(infog1: i64) -> &'static str {
 
 /// The failure of the last solve of `ksp` (collective: every rank gets the same answer for
 /// MUMPS, whose INFOG is global).
-pub fn last_failure(ksp: ffi::KSP) -> Result<LinearFailure> {
+pub(crate) fn last_failure(ksp: ffi::KSP) -> Result<LinearFailure> {
     let mut reason: ffi::KSPConvergedReason = 0;
     pcall!(ffi::KSPGetConvergedReason(ksp, &mut reason))?;
     let mut s: *const std::os::raw::c_char = std::ptr::null();
@@ -129,5 +135,6 @@ mod tests {
         assert!(f.mumps_workspace_too_small());
         assert!(f.to_string().contains("INFOG(1) = -9") && f.to_string().contains("delayed pivots"), "{f}");
         assert!(mumps_meaning(-10).contains("singular"));
+        assert!(mumps_memory_code(-13) && mumps_memory_code(-19) && !mumps_memory_code(-9) && !mumps_memory_code(-10));
     }
 }

@@ -207,6 +207,14 @@ impl Newton<'_> {
             self.x.set_local_values(&start[lo..hi]).map_err(pe)?;
             system.take_collapse();
             r = self.snes.solve(system, &self.x, self.j).map_err(pe)?;
+            if r.reason_code == petsc::ffi::SNESConvergedReason_SNES_DIVERGED_LINEAR_SOLVE {
+                // Out of the machine's memory or of the user's MUMPS memory limit: no milder
+                // problem has a smaller factorisation, so the continuation would only repeat it.
+                let why = self.snes.linear_failure().map_err(pe)?;
+                if why.mumps_infog.is_some_and(|(i, _)| petsc::factor::mumps_memory_code(i)) {
+                    return Err(format!("the linear solver cannot factorise the Jacobian: {why}"));
+                }
+            }
         }
         if let (false, Some(c)) = (r.converged, system.take_collapse()) {
             r.reason = format!("{}: film closed at ({:.3}, {:.3})a", r.reason, c[0], c[1]);
@@ -383,27 +391,20 @@ pub(super) fn newton_with_continuation(
         base.reynolds.penalty = PENALTY_START;
     }
     // 1. Plain Newton from the start at the base problem.
-    let report = if opts.skip_plain || !policy.plain_first {
-        SolveReport {
-            converged: false,
-            reason: "SKIPPED".into(),
-            reason_code: 0,
-            iterations: 0,
-            linear_iterations: 0,
-            residual_norm: f64::NAN,
-            domain_error: None,
-        }
-    } else {
-        nw.solve(&base, system, x0)?
-    };
-    let at_xi = if staged { format!(", xi = {PENALTY_START:e}") } else { String::new() };
-    if policy.plain_first {
+    // The last solve's report; none when plain Newton is skipped and no continuation step
+    // gets to a solve.
+    let mut last: Option<SolveReport> = None;
+    let mut state: Option<Vec<f64>> = None;
+    if policy.plain_first && !opts.skip_plain {
+        let report = nw.solve(&base, system, x0)?;
+        let at_xi = if staged { format!(", xi = {PENALTY_START:e}") } else { String::new() };
         nw.note(format!("Newton from {label} at L = {target} N{at_xi}: {} ({} iterations)", report.reason, report.iterations));
+        nw.iterations = report.iterations;
+        if report.converged {
+            state = Some(nw.solution()?);
+        }
+        last = Some(report);
     }
-    nw.iterations = report.iterations;
-    let mut last = report;
-    // The converged state of the base problem.
-    let mut state: Option<Vec<f64>> = if last.converged { Some(nw.solution()?) } else { None };
     let continued = state.is_none();
     // 2. If it failed: the continuations, each from a milder problem back to the base one.
     if state.is_none() && policy.continues {
@@ -414,7 +415,7 @@ pub(super) fn newton_with_continuation(
             }
             let Some((t, from)) = nw.search(&base, &h, system, x0, label)? else { continue };
             let (done, r, xs) = nw.ramp(&base, &h, t, from, system)?;
-            if let Some(r) = r {
+            if r.is_some() {
                 last = r;
             }
             if done {
@@ -441,22 +442,29 @@ pub(super) fn newton_with_continuation(
         let first = PENALTY_START / xi;
         let h = Homotopy { parameter: Parameter::Penalty(xi), ramp: Ramp { first, lowest: first, ratio: xi / PENALTY_START } };
         let (done, r, xs) = nw.ramp(scene, &h, first, from, system)?;
-        if let Some(r) = r {
+        if r.is_some() {
             last = r;
         }
         state = if done { Some(xs) } else { None };
     }
-    let Some(xs) = state else {
+    let (Some(xs), Some(last)) = (state, last.as_ref()) else {
+        let end = match &last {
+            Some(r) => format!(
+                "{} after {} iterations (residual norm {:.3e}){}",
+                r.reason,
+                r.iterations,
+                r.residual_norm,
+                r.domain_error.as_ref().map(|d| format!("; last domain error: {d}")).unwrap_or_default()
+            ),
+            None => "no continuation step reached a solve".into(),
+        };
         return Err(format!(
-            "Newton did not converge: {} after {} iterations (residual norm {:.3e}){}{}; path: {}",
-            last.reason,
-            last.iterations,
-            last.residual_norm,
-            last.domain_error.as_ref().map(|d| format!("; last domain error: {d}")).unwrap_or_default(),
+            "Newton did not converge: {end}{}; path: {}",
             nw.collapse.and_then(|c| c.at_pole()).map(|w| format!("; {w}")).unwrap_or_default(),
             nw.steps.join("; ")
         ));
     };
+    let last = last.clone();
     Ok(NewtonOutcome { x: xs, report: last, newton_total: nw.iterations, steps: nw.steps, continued })
 }
 
