@@ -1,4 +1,4 @@
-//! Axes and ticks: linear and log scales, tick placement and labels, data ranges, checks.
+//! Axes and ticks: linear and log scales, tick placement and labels, frame, grid.
 use super::*;
 
 #[derive(Clone, Debug)]
@@ -20,10 +20,6 @@ pub(super) struct Tick {
 }
 
 impl Axis {
-    /// Axis over `r` with about `target` tick intervals; the pixel ends are set later.
-    pub(super) fn new(r: (f64, f64), log: bool, target: usize) -> Axis {
-        Axis { lo: r.0, hi: r.1, log, p0: 0.0, p1: 1.0, target }
-    }
     pub(super) fn t(&self, v: f64) -> f64 {
         if self.log {
             v.log10()
@@ -175,6 +171,10 @@ pub(super) fn check_range(r: (f64, f64), log: bool, what: &str) -> Result<(f64, 
     Ok(r)
 }
 
+pub(super) fn max_label_width(ticks: &[Tick], size: f64) -> i32 {
+    ticks.iter().filter_map(|t| t.label.as_ref()).map(|l| text_size(l, size).0).max().unwrap_or(0)
+}
+
 /// Plot box in pixels: left, top, right, bottom.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BoxPx {
@@ -182,6 +182,71 @@ pub(super) struct BoxPx {
     pub(super) t: i32,
     pub(super) r: i32,
     pub(super) b: i32,
+}
+
+/// Light grid lines at the ticks (drawn under the data).
+pub(super) fn draw_grid(cv: &mut Canvas, bx: BoxPx, x: &Axis, y: &Axis) {
+    for t in x.ticks() {
+        let p = x.px(t.v).round() as i32;
+        if p > bx.l && p < bx.r {
+            cv.vline(p, bx.t, bx.b, if t.major { (220, 220, 220) } else { (240, 240, 240) });
+        }
+    }
+    for t in y.ticks() {
+        let p = y.px(t.v).round() as i32;
+        if p > bx.t && p < bx.b {
+            cv.hline(bx.l, bx.r, p, if t.major { (220, 220, 220) } else { (240, 240, 240) });
+        }
+    }
+}
+
+/// Vertical tick marks and labels on the left or right side at pixel column `x0`; returns
+/// the width of the widest label.
+pub(super) fn y_ticks(cv: &mut Canvas, ax: &Axis, x0: i32, right: bool, bx: BoxPx) -> i32 {
+    let mut maxw = 0;
+    for t in ax.ticks() {
+        let p = ax.px(t.v).round() as i32;
+        if p < bx.t || p > bx.b {
+            continue;
+        }
+        let len = if t.major { TICK_LEN } else { TICK_LEN / 2 };
+        if right {
+            cv.hline(x0, x0 + len, p, BLACK);
+        } else {
+            cv.hline(x0 - len, x0, p, BLACK);
+        }
+        if let Some(l) = &t.label {
+            let (xx, hp) = if right { (x0 + TICK_LEN + 5, HPos::Left) } else { (x0 - TICK_LEN - 5, HPos::Right) };
+            cv.text(l, xx, p, TICK_SIZE, hp, VPos::Center, false);
+            maxw = maxw.max(text_size(l, TICK_SIZE).0);
+        }
+    }
+    maxw
+}
+
+/// Frame, tick marks and labels of x (bottom), y (left) and optionally y2 (right).
+pub(super) fn draw_frame(cv: &mut Canvas, bx: BoxPx, x: &Axis, y: &Axis, y2: Option<&Axis>, labels: (&str, &str, &str)) {
+    cv.rect_outline(bx.l, bx.t, bx.r, bx.b, BLACK);
+    let mut max_h = 0;
+    for t in x.ticks() {
+        let p = x.px(t.v).round() as i32;
+        if p < bx.l || p > bx.r {
+            continue;
+        }
+        cv.vline(p, bx.b, bx.b + if t.major { TICK_LEN } else { TICK_LEN / 2 }, BLACK);
+        if let Some(l) = &t.label {
+            cv.text(l, p, bx.b + TICK_LEN + 4, TICK_SIZE, HPos::Center, VPos::Top, false);
+            max_h = max_h.max(text_size(l, TICK_SIZE).1);
+        }
+    }
+    let (cx, cy) = ((bx.l + bx.r) / 2, (bx.t + bx.b) / 2);
+    cv.text(labels.0, cx, bx.b + TICK_LEN + 4 + max_h + 10, LABEL_SIZE, HPos::Center, VPos::Top, false);
+    let wy = y_ticks(cv, y, bx.l, false, bx);
+    cv.text(labels.1, bx.l - TICK_LEN - 5 - wy - 12, cy, LABEL_SIZE, HPos::Center, VPos::Bottom, true);
+    if let Some(y2) = y2 {
+        let w2 = y_ticks(cv, y2, bx.r, true, bx);
+        cv.text(labels.2, bx.r + TICK_LEN + 5 + w2 + 12, cy, LABEL_SIZE, HPos::Center, VPos::Top, true);
+    }
 }
 
 /// Dashed circle (cx, cy, r) in data units, clipped to the box.
@@ -193,5 +258,13 @@ pub(super) fn check_finite(vals: impl IntoIterator<Item = f64>, what: &str) -> R
     match vals.into_iter().enumerate().find(|(_, v)| !v.is_finite()) {
         Some((i, v)) => Err(format!("{what}: value {i} is {v} (all plot data must be finite)")),
         None => Ok(()),
+    }
+}
+
+pub(super) fn title_band(title: &str) -> i32 {
+    if title.is_empty() {
+        20
+    } else {
+        text_size(title, TITLE_SIZE).1 + 30
     }
 }

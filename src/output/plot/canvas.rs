@@ -1,5 +1,5 @@
-//! Canvas and colours: our anti-aliased rasteriser (lines, discs, triangles, dashed ellipses)
-//! on the RGB buffer that plotters also draws into, the PNG file, the colour maps.
+//! Canvas, text, colours: the rasteriser (lines, discs, triangles, Gouraud shading), text
+//! with ab_glyph, the colour maps.
 use super::*;
 
 pub(super) type Rgb = (u8, u8, u8);
@@ -20,6 +20,33 @@ pub(super) const LABEL_SIZE: f64 = 19.0;
 pub(super) const TICK_SIZE: f64 = 16.0;
 pub(super) const TICK_LEN: i32 = 6;
 
+/// Horizontal anchor of a text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum HPos {
+    Left,
+    Center,
+    Right,
+}
+/// Vertical anchor of a text (top or bottom of the ascent-descent box).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum VPos {
+    Top,
+    Center,
+    Bottom,
+}
+
+/// A piece of text drawn last (on top); anchored at (x, y) in the text's own frame; `rot`
+/// turns it 90 degrees counter-clockwise about the anchor (reads bottom to top).
+pub(super) struct TextCmd {
+    pub(super) s: String,
+    pub(super) x: i32,
+    pub(super) y: i32,
+    pub(super) size: f64,
+    pub(super) h: HPos,
+    pub(super) v: VPos,
+    pub(super) rot: bool,
+}
+
 pub(super) fn check_size(w: u32, h: u32) -> Result<(), String> {
     if !(200..=10000).contains(&w) || !(150..=10000).contains(&h) {
         return Err(format!("plot size {w}x{h} out of range (200..10000 x 150..10000)"));
@@ -30,17 +57,18 @@ pub(super) fn check_size(w: u32, h: u32) -> Result<(), String> {
 pub(super) const BLACK: Rgb = (0, 0, 0);
 pub(super) const WHITE: Rgb = (255, 255, 255);
 
-/// RGB image with a few anti-aliased primitives; plotters draws into the same buffer.
+/// RGB image with a few anti-aliased primitives; text is queued and drawn by [`Canvas::save`].
 pub(super) struct Canvas {
     pub(super) w: u32,
     pub(super) h: u32,
     pub(super) buf: Vec<u8>,
+    pub(super) texts: Vec<TextCmd>,
 }
 
 impl Canvas {
     pub(super) fn new(w: u32, h: u32) -> Result<Canvas, String> {
         check_size(w, h)?;
-        Ok(Canvas { w, h, buf: vec![255; (w * h * 3) as usize] })
+        Ok(Canvas { w, h, buf: vec![255; (w * h * 3) as usize], texts: Vec::new() })
     }
     pub(super) fn set(&mut self, x: i32, y: i32, c: Rgb) {
         self.blend(x, y, c, 1.0);
@@ -62,6 +90,18 @@ impl Canvas {
                 self.set(x, y, c);
             }
         }
+    }
+    pub(super) fn hline(&mut self, x0: i32, x1: i32, y: i32, c: Rgb) {
+        self.fill_rect(x0.min(x1), y, x0.max(x1), y, c);
+    }
+    pub(super) fn vline(&mut self, x: i32, y0: i32, y1: i32, c: Rgb) {
+        self.fill_rect(x, y0.min(y1), x, y0.max(y1), c);
+    }
+    pub(super) fn rect_outline(&mut self, l: i32, t: i32, r: i32, b: i32, c: Rgb) {
+        self.hline(l, r, t, c);
+        self.hline(l, r, b, c);
+        self.vline(l, t, b, c);
+        self.vline(r, t, b, c);
     }
     /// Applies a coverage function over a pixel window (clipped to `clip` and the image):
     /// `cov(px, py)` gets the pixel centre and returns the coverage in [0, 1].
@@ -133,6 +173,12 @@ impl Canvas {
             }
         }
     }
+    /// Anti-aliased filled disc.
+    pub(super) fn disc(&mut self, cx: f64, cy: f64, r: f64, c: Rgb, clip: BoxPx) {
+        self.paint((cx - r - 1.0, cy - r - 1.0, cx + r + 1.0, cy + r + 1.0), clip, c, |x, y| {
+            (r + 0.5 - ((x - cx).powi(2) + (y - cy).powi(2)).sqrt()).clamp(0.0, 1.0)
+        });
+    }
     /// Anti-aliased filled triangle.
     pub(super) fn triangle(&mut self, p: [(f64, f64); 3], c: Rgb, clip: BoxPx) {
         let area = (p[1].0 - p[0].0) * (p[2].1 - p[0].1) - (p[2].0 - p[0].0) * (p[1].1 - p[0].1);
@@ -188,8 +234,47 @@ impl Canvas {
             }
         }
     }
-    /// Encodes the PNG and writes it atomically.
-    pub(super) fn save(self, path: &Path) -> Result<(), String> {
+    pub(super) fn render_text(&mut self, font: &FontVec, t: &TextCmd) {
+        let sf = font.as_scaled(PxScale::from(t.size as f32));
+        let (w, h) = text_size(&t.s, t.size);
+        let ax = match t.h {
+            HPos::Left => 0,
+            HPos::Center => w / 2,
+            HPos::Right => w,
+        };
+        let ay = match t.v {
+            VPos::Top => 0,
+            VPos::Center => h / 2,
+            VPos::Bottom => h,
+        };
+        let mut caret = 0.0f32;
+        let mut prev = None;
+        for c in t.s.chars() {
+            let id = sf.glyph_id(c);
+            if let Some(p) = prev {
+                caret += sf.kern(p, id);
+            }
+            prev = Some(id);
+            let glyph = id.with_scale_and_position(sf.scale(), ab_glyph::point(caret, sf.ascent()));
+            caret += sf.h_advance(id);
+            if let Some(og) = font.outline_glyph(glyph) {
+                let bb = og.px_bounds();
+                let mut px = Vec::new();
+                og.draw(|gx, gy, a| px.push((bb.min.x as i32 + gx as i32, bb.min.y as i32 + gy as i32, a)));
+                for (u, v, a) in px {
+                    // (u, v): pixel in the text's own frame, top-left of the text box at (0, 0)
+                    let (sx, sy) = if t.rot { (t.x + v - ay, t.y - u + ax) } else { (t.x + u - ax, t.y + v - ay) };
+                    self.blend(sx, sy, BLACK, a as f64);
+                }
+            }
+        }
+    }
+    /// Draws the queued text, encodes the PNG and writes it atomically.
+    pub(super) fn save(mut self, path: &Path) -> Result<(), String> {
+        let font = font()?;
+        for t in std::mem::take(&mut self.texts) {
+            self.render_text(font, &t);
+        }
         let mut png_bytes = Vec::new();
         {
             let mut enc = png::Encoder::new(&mut png_bytes, self.w, self.h);
@@ -200,9 +285,36 @@ impl Canvas {
         }
         crate::output::write_atomic(path, &png_bytes).map_err(|e| format!("cannot write plot '{}': {e}", path.display()))
     }
+    /// Queues `s` anchored at (x, y); `rot` turns it 90 degrees counter-clockwise (reads bottom to top).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn text(&mut self, s: &str, x: i32, y: i32, size: f64, h: HPos, v: VPos, rot: bool) {
+        if !s.is_empty() {
+            self.texts.push(TextCmd { s: s.to_string(), x, y, size, h, v, rot });
+        }
+    }
     pub(super) fn full(&self) -> BoxPx {
         BoxPx { l: 0, t: 0, r: self.w as i32 - 1, b: self.h as i32 - 1 }
     }
+}
+
+/// Width and height (ascent - descent) of `s` in pixels at `size` (0, 0 without a font).
+pub(super) fn text_size(s: &str, size: f64) -> (i32, i32) {
+    let Ok(font) = font() else { return (0, 0) };
+    if s.is_empty() {
+        return (0, 0);
+    }
+    let sf = font.as_scaled(PxScale::from(size as f32));
+    let mut w = 0.0f32;
+    let mut prev = None;
+    for c in s.chars() {
+        let id = sf.glyph_id(c);
+        if let Some(p) = prev {
+            w += sf.kern(p, id);
+        }
+        w += sf.h_advance(id);
+        prev = Some(id);
+    }
+    (w.ceil() as i32, (sf.ascent() - sf.descent()).ceil() as i32)
 }
 
 pub(super) fn lerp_table(table: &[(f64, Rgb)], t: f64) -> Rgb {

@@ -1,7 +1,5 @@
 //! Line plots: series on linear or log axes, secondary y axis, legend.
 use super::*;
-use plotters::prelude::{BitMapBackend, ChartBuilder, Circle, Color, EmptyElement, IntoDrawingArea, LineSeries, PathElement};
-use plotters::prelude::{SeriesLabelPosition, TRANSPARENT};
 
 /// Line/point plot of one or more series, optionally with log axes and a secondary y axis.
 pub fn line_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &[Series], opts: &LineOpts) -> Result<(), String> {
@@ -40,82 +38,86 @@ pub fn line_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &
     let yr = yr_of(false, opts.log_y, opts.y_range, "y")?;
     let y2r = yr_of(true, opts.log_y2, opts.y2_range, "y2")?;
 
-    let mut x = Axis::new(xr, opts.log_x, 8);
-    let mut y = Axis::new(yr, opts.log_y, 6);
-    let y2 = Axis::new(y2r, opts.log_y2, 6);
-    let mut cv = Canvas::new(opts.width, opts.height)?;
-    let root = BitMapBackend::with_buffer(&mut cv.buf, (opts.width, opts.height)).into_drawing_area();
-    title_text(&root, title)?;
-    let right = if has_y2 { 15 } else { max_label_width(&x) / 2 + 20 };
-    let mut chart = ChartBuilder::on(&root)
-        .margin_top(title_band(title))
-        .margin_left(15)
-        .margin_right(right)
-        .margin_bottom(15)
-        .x_label_area_size(x_area(xlabel))
-        .y_label_area_size(y_area(&y, ylabel))
-        .right_y_label_area_size(if has_y2 { y_area(&y2, &opts.y2label) } else { 0 })
-        .build_cartesian_2d(x.clone(), y.clone())
-        .map_err(pe)?
-        .set_secondary_coord(x.clone(), y2.clone());
-    let (pw, ph) = chart.plotting_area().dim_in_pixel();
-    if pw < 50 || ph < 50 {
-        return Err(format!("line_plot: {}x{} pixels is too small for the labels", opts.width, opts.height));
-    }
-    draw_frame(&root, &mut chart, &mut x, &mut y, (xlabel, ylabel), opts.grid)?;
-    if has_y2 {
-        let mut axes = chart.configure_secondary_axes();
-        axes.label_style(font(TICK_SIZE)).axis_desc_style(font(LABEL_SIZE)).set_all_tick_mark_size(TICK_LEN);
-        if !opts.y2label.is_empty() {
-            axes.y_desc(&opts.y2label);
-        }
-        axes.draw().map_err(pe)?;
-    }
-    for (i, s) in series.iter().enumerate() {
-        let c = rgb(s.color.unwrap_or(PALETTE[i % PALETTE.len()]));
-        let pts: Vec<(f64, f64)> = s.x.iter().copied().zip(s.y.iter().copied()).collect();
-        let line = matches!(s.style, Style::Line | Style::LinePoints);
-        let dots = matches!(s.style, Style::Points | Style::LinePoints);
-        let ls = if line { c.stroke_width(2) } else { TRANSPARENT.stroke_width(0) };
-        let ds = if dots { c.filled() } else { TRANSPARENT.filled() };
-        let elems = pts.iter().map(|&p| Circle::new(p, 4, ds));
-        let anno = match (s.secondary, line) {
-            (false, true) => chart.draw_series(LineSeries::new(pts.clone(), ls)),
-            (true, true) => chart.draw_secondary_series(LineSeries::new(pts.clone(), ls)),
-            (false, false) => chart.draw_series(elems.clone()),
-            (true, false) => chart.draw_secondary_series(elems.clone()),
-        }
-        .map_err(pe)?;
-        if !s.label.is_empty() {
-            let label = if s.secondary { format!("{} (right axis)", s.label) } else { s.label.clone() };
-            anno.label(label)
-                .legend(move |(lx, ly)| EmptyElement::at((lx, ly)) + PathElement::new([(0, 0), (34, 0)], ls) + Circle::new((17, 0), 4, ds));
-        }
-        if line && dots {
-            if s.secondary { chart.draw_secondary_series(elems) } else { chart.draw_series(elems) }.map_err(pe)?;
-        }
-    }
-    let pos = match opts.legend {
-        Legend::None => None,
-        Legend::UpperRight => Some(SeriesLabelPosition::UpperRight),
-        Legend::UpperLeft => Some(SeriesLabelPosition::UpperLeft),
-        Legend::LowerRight => Some(SeriesLabelPosition::LowerRight),
-        Legend::LowerLeft => Some(SeriesLabelPosition::LowerLeft),
+    let (w, h) = (opts.width as i32, opts.height as i32);
+    let mut x = Axis { lo: xr.0, hi: xr.1, log: opts.log_x, p0: 0.0, p1: 1.0, target: 8 };
+    let mut y = Axis { lo: yr.0, hi: yr.1, log: opts.log_y, p0: 1.0, p1: 0.0, target: 6 };
+    let mut y2 = Axis { lo: y2r.0, hi: y2r.1, log: opts.log_y2, p0: 1.0, p1: 0.0, target: 6 };
+    let label_h = text_size("Xg", LABEL_SIZE).1;
+    let tick_h = text_size("0", TICK_SIZE).1;
+    let left = 15 + if ylabel.is_empty() { 0 } else { label_h + 12 } + max_label_width(&y.ticks(), TICK_SIZE) + TICK_LEN + 5;
+    let right = if has_y2 {
+        15 + if opts.y2label.is_empty() { 0 } else { label_h + 12 } + max_label_width(&y2.ticks(), TICK_SIZE) + TICK_LEN + 5
+    } else {
+        max_label_width(&x.ticks(), TICK_SIZE) / 2 + 20
     };
-    if let Some(pos) = pos.filter(|_| series.iter().any(|s| !s.label.is_empty())) {
-        chart
-            .configure_series_labels()
-            .position(pos)
-            .margin(10)
-            .legend_area_size(44)
-            .label_font(font(TICK_SIZE))
-            .background_style(rgb(WHITE))
-            .border_style(rgb((160, 160, 160)))
-            .draw()
-            .map_err(pe)?;
+    let top = title_band(title);
+    let bottom = TICK_LEN + 4 + tick_h + if xlabel.is_empty() { 0 } else { 10 + label_h } + 15;
+    let bx = BoxPx { l: left, t: top, r: w - right, b: h - bottom };
+    if bx.r - bx.l < 50 || bx.b - bx.t < 50 {
+        return Err(format!("line_plot: {w}x{h} pixels is too small for the labels"));
     }
-    root.present().map_err(pe)?;
-    drop(chart);
-    drop(root);
+    x.p0 = bx.l as f64;
+    x.p1 = bx.r as f64;
+    for a in [&mut y, &mut y2] {
+        a.p0 = bx.b as f64;
+        a.p1 = bx.t as f64;
+    }
+
+    let mut cv = Canvas::new(opts.width, opts.height)?;
+    cv.text(title, w / 2, 15, TITLE_SIZE, HPos::Center, VPos::Top, false);
+    if opts.grid {
+        draw_grid(&mut cv, bx, &x, &y);
+    }
+    let inner = BoxPx { l: bx.l + 1, t: bx.t + 1, r: bx.r - 1, b: bx.b - 1 };
+    let mut entries = Vec::new();
+    for (i, s) in series.iter().enumerate() {
+        let c = s.color.unwrap_or(PALETTE[i % PALETTE.len()]);
+        let ya = if s.secondary { &y2 } else { &y };
+        let pts: Vec<(f64, f64)> = s.x.iter().zip(&s.y).map(|(&a, &b)| (x.px(a), ya.px(b))).collect();
+        if matches!(s.style, Style::Line | Style::LinePoints) {
+            cv.stroke(&pts, 2.2, c, inner);
+        }
+        if matches!(s.style, Style::Points | Style::LinePoints) {
+            for p in &pts {
+                cv.disc(p.0, p.1, 4.0, c, inner);
+            }
+        }
+        if !s.label.is_empty() {
+            let label = if s.secondary && has_y2 { format!("{} (right axis)", s.label) } else { s.label.clone() };
+            entries.push((label, c, s.style));
+        }
+    }
+    draw_frame(&mut cv, bx, &x, &y, has_y2.then_some(&y2), (xlabel, ylabel, &opts.y2label));
+    draw_legend(&mut cv, bx, opts.legend, &entries);
     cv.save(path)
+}
+
+pub(super) fn draw_legend(cv: &mut Canvas, bx: BoxPx, pos: Legend, entries: &[(String, Rgb, Style)]) {
+    if pos == Legend::None || entries.is_empty() {
+        return;
+    }
+    let row = text_size("Xg", TICK_SIZE).1 + 8;
+    let sample = 34;
+    let lw = entries.iter().map(|e| text_size(&e.0, TICK_SIZE).0).max().unwrap_or(0);
+    let (bw, bh) = (10 + sample + 8 + lw + 12, 8 + row * entries.len() as i32 + 4);
+    let (x0, y0) = match pos {
+        Legend::UpperRight => (bx.r - 10 - bw, bx.t + 10),
+        Legend::UpperLeft => (bx.l + 10, bx.t + 10),
+        Legend::LowerRight => (bx.r - 10 - bw, bx.b - 10 - bh),
+        Legend::LowerLeft | Legend::None => (bx.l + 10, bx.b - 10 - bh),
+    };
+    cv.fill_rect(x0, y0, x0 + bw, y0 + bh, WHITE);
+    cv.rect_outline(x0, y0, x0 + bw, y0 + bh, (160, 160, 160));
+    let full = cv.full();
+    for (i, (label, c, style)) in entries.iter().enumerate() {
+        let cy = y0 + 6 + row * i as i32 + row / 2;
+        let (sx0, sx1) = (x0 + 10, x0 + 10 + sample);
+        if matches!(style, Style::Line | Style::LinePoints) {
+            cv.stroke(&[(sx0 as f64, cy as f64 + 0.5), (sx1 as f64, cy as f64 + 0.5)], 2.2, *c, full);
+        }
+        if matches!(style, Style::Points | Style::LinePoints) {
+            cv.disc((sx0 + sx1) as f64 / 2.0, cy as f64 + 0.5, 4.0, *c, full);
+        }
+        cv.text(label, sx1 + 8, cy, TICK_SIZE, HPos::Left, VPos::Center, false);
+    }
 }

@@ -1,6 +1,5 @@
 //! Colour maps of a scalar field on a triangle mesh, with colour bar.
 use super::*;
-use plotters::prelude::{BitMapBackend, ChartBuilder, IntoDrawingArea};
 
 /// Plot box for a 2-D field: fills the available space, or the largest box with equal scales;
 /// then the canvas (w, h) loses the unused band, keeping at least `min_w` of width.
@@ -70,61 +69,36 @@ pub fn map_plot(
     };
     let cmap: fn(f64) -> Rgb = if opts.diverging { blue_white_red } else { viridis };
 
-    let (mut x, mut y) = (Axis::new(xr, false, 6), Axis::new(yr, false, 6));
-    let cbax = Axis::new((vlo, vhi), false, 8);
-    let (cb_gap, cb_w, cb_area) = (25, 24, y_area(&cbax, &opts.colorbar_label));
-    let (left, bottom) = (y_area(&y, ylabel), x_area(xlabel));
     let (w, h) = (opts.width as i32, opts.height as i32);
-    let avail = BoxPx { l: 15 + left, t: title_band(title), r: w - 15 - cb_area - cb_w - cb_gap, b: h - 15 - bottom };
+    let mut x = Axis { lo: xr.0, hi: xr.1, log: false, p0: 0.0, p1: 1.0, target: 6 };
+    let mut y = Axis { lo: yr.0, hi: yr.1, log: false, p0: 1.0, p1: 0.0, target: 6 };
+    let cb_ticks = linear_ticks(vlo, vhi, 8);
+    let label_h = text_size("Xg", LABEL_SIZE).1;
+    let tick_h = text_size("0", TICK_SIZE).1;
+    let (cb_gap, cb_w) = (25, 24);
+    let left = 15 + if ylabel.is_empty() { 0 } else { label_h + 12 } + max_label_width(&y.ticks(), TICK_SIZE) + TICK_LEN + 5;
+    let right = 15
+        + if opts.colorbar_label.is_empty() { 0 } else { label_h + 12 }
+        + max_label_width(&cb_ticks, TICK_SIZE)
+        + TICK_LEN
+        + 5
+        + cb_w
+        + cb_gap;
+    let top = title_band(title);
+    let bottom = TICK_LEN + 4 + tick_h + if xlabel.is_empty() { 0 } else { 10 + label_h } + 15;
+    let avail = BoxPx { l: left, t: top, r: w - right, b: h - bottom };
     if avail.r - avail.l < 50 || avail.b - avail.t < 50 {
         return Err(format!("map_plot: {w}x{h} pixels is too small for the labels"));
     }
     let min_w = text_size(title, TITLE_SIZE).0 + 40;
     let (bx, w, h) = fit_box(avail, xr, yr, opts.equal_aspect, w, h, min_w);
     let mut cv = Canvas::new(w as u32, h as u32)?;
-    let cb = BoxPx { l: bx.r + cb_gap, t: bx.t, r: bx.r + cb_gap + cb_w, b: bx.b };
-    check_finite(opts.edges.iter().flatten().flatten().copied(), "map_plot: edges")?;
-    let bx = {
-        let root = BitMapBackend::with_buffer(&mut cv.buf, (w as u32, h as u32)).into_drawing_area();
-        title_text(&root, title)?;
-        let mut chart = ChartBuilder::on(&root)
-            .margin_top(bx.t)
-            .margin_left(bx.l - left)
-            .margin_right(w - bx.r)
-            .margin_bottom(h - bx.b - bottom)
-            .x_label_area_size(bottom)
-            .y_label_area_size(left)
-            .build_cartesian_2d(x.clone(), y.clone())
-            .map_err(pe)?;
-        let bx = draw_frame(&root, &mut chart, &mut x, &mut y, (xlabel, ylabel), false)?;
-        // colour bar: plotters draws its axis, we fill the gradient below
-        let (cbx, cby) = (Axis::new((0.0, 1.0), false, 1), cbax);
-        let mut bar = ChartBuilder::on(&root)
-            .margin_top(cb.t)
-            .margin_left(cb.l)
-            .margin_right(w - cb.r - cb_area)
-            .margin_bottom(h - cb.b)
-            .right_y_label_area_size(cb_area)
-            .build_cartesian_2d(cbx.clone(), cby.clone())
-            .map_err(pe)?;
-        let mut mesh = bar.configure_mesh();
-        mesh.disable_mesh()
-            .disable_x_axis()
-            .label_style(font(TICK_SIZE))
-            .axis_desc_style(font(LABEL_SIZE))
-            .set_all_tick_mark_size(TICK_LEN);
-        if !opts.colorbar_label.is_empty() {
-            mesh.y_desc(&opts.colorbar_label);
-        }
-        mesh.draw().map_err(pe)?;
-        frame_rect(&root, cb)?;
-        root.present().map_err(pe)?;
-        bx
-    };
-    let inner = |b: BoxPx| BoxPx { l: b.l + 1, t: b.t + 1, r: b.r - 1, b: b.b - 1 };
+    x.p0 = bx.l as f64;
+    x.p1 = bx.r as f64;
+    y.p0 = bx.b as f64;
+    y.p1 = bx.t as f64;
 
     // raster the triangles: pixel centres inside the box, barycentric interpolation
-    let ib = inner(bx);
     let vnorm = |v: f64| (v - vlo) / (vhi - vlo);
     for (tri, val) in tris.iter().zip(values) {
         let p: Vec<(f64, f64)> = tri.iter().map(|q| (x.px(q[0]), y.px(q[1]))).collect();
@@ -132,10 +106,10 @@ pub fn map_plot(
         if det.abs() < 1e-12 {
             continue;
         }
-        let xmin = p.iter().map(|q| q.0).fold(f64::INFINITY, f64::min).floor().max(ib.l as f64) as i32;
-        let xmax = p.iter().map(|q| q.0).fold(f64::NEG_INFINITY, f64::max).ceil().min(ib.r as f64) as i32;
-        let ymin = p.iter().map(|q| q.1).fold(f64::INFINITY, f64::min).floor().max(ib.t as f64) as i32;
-        let ymax = p.iter().map(|q| q.1).fold(f64::NEG_INFINITY, f64::max).ceil().min(ib.b as f64) as i32;
+        let xmin = p.iter().map(|q| q.0).fold(f64::INFINITY, f64::min).floor().max(bx.l as f64) as i32;
+        let xmax = p.iter().map(|q| q.0).fold(f64::NEG_INFINITY, f64::max).ceil().min(bx.r as f64 - 1.0) as i32;
+        let ymin = p.iter().map(|q| q.1).fold(f64::INFINITY, f64::min).floor().max(bx.t as f64) as i32;
+        let ymax = p.iter().map(|q| q.1).fold(f64::NEG_INFINITY, f64::max).ceil().min(bx.b as f64 - 1.0) as i32;
         let eps = 1e-9;
         for py in ymin..=ymax {
             for px in xmin..=xmax {
@@ -150,16 +124,28 @@ pub fn map_plot(
             }
         }
     }
+    check_finite(opts.edges.iter().flatten().flatten().copied(), "map_plot: edges")?;
     for e in &opts.edges {
-        cv.stroke(&[(x.px(e[0][0]), y.px(e[0][1])), (x.px(e[1][0]), y.px(e[1][1]))], 0.6, (30, 30, 30), ib);
+        cv.stroke(&[(x.px(e[0][0]), y.px(e[0][1])), (x.px(e[1][0]), y.px(e[1][1]))], 0.6, (30, 30, 30), bx);
     }
     if let Some(c) = opts.circle {
-        draw_circle(&mut cv, &x, &y, c, ib);
+        draw_circle(&mut cv, &x, &y, c, bx);
     }
-    let ic = inner(cb);
-    for py in ic.t..=ic.b {
+    // colour bar
+    let cb = BoxPx { l: bx.r + cb_gap, t: bx.t, r: bx.r + cb_gap + cb_w, b: bx.b };
+    for py in cb.t..cb.b {
         let t = (cb.b as f64 - (py as f64 + 0.5)) / (cb.b - cb.t) as f64;
-        cv.fill_rect(ic.l, py, ic.r, py, cmap(t));
+        for px in cb.l..cb.r {
+            cv.set(px, py, cmap(t));
+        }
     }
+    cv.rect_outline(cb.l, cb.t, cb.r, cb.b, BLACK);
+    let cbax = Axis { lo: vlo, hi: vhi, log: false, p0: cb.b as f64, p1: cb.t as f64, target: 8 };
+    let maxw = y_ticks(&mut cv, &cbax, cb.r, true, cb);
+
+    cv.text(title, w / 2, 15, TITLE_SIZE, HPos::Center, VPos::Top, false);
+    draw_frame(&mut cv, bx, &x, &y, None, (xlabel, ylabel, ""));
+    let cbl = cb.r + TICK_LEN + 5 + maxw + 12;
+    cv.text(&opts.colorbar_label, cbl, (cb.t + cb.b) / 2, LABEL_SIZE, HPos::Center, VPos::Top, true);
     cv.save(path)
 }

@@ -1,28 +1,24 @@
 //! PNG plots: line plots (linear or log axes, legend, optional secondary y axis), filled colour
 //! maps of a scalar field on a triangle mesh (with colour bar), and quiver (arrow) plots.
 //!
-//! Pure Rust, no system libraries. The `plotters` crate (bitmap backend, `ab_glyph` text)
-//! draws the charts: title, axes, ticks, tick and axis labels, grid, line series, points,
-//! legends, the colour bar's axis. Our own small anti-aliased rasteriser ([`canvas`]) draws
-//! what plotters has no element for: the linearly interpolated (Gouraud) colour fill of the
-//! mesh triangles, the colour bar's gradient, mesh edges thinner than a pixel, the dashed
-//! black-and-white contact circle and the arrows. Ticks and their labels are ours too
-//! ([`axes`]: 1-2-5 steps, 10ⁿ labels on log axes). Both draw into one RGB buffer, which the
-//! `png` crate encodes; files are written atomically ([`super::write_atomic`]).
+//! Pure Rust, no system libraries: a small anti-aliased rasteriser of our own (lines, discs,
+//! triangles, dashed circles, Gouraud-shaded mesh triangles) draws into an RGB buffer, `ab_glyph`
+//! renders the text, and the `png` crate encodes the image. Files are written atomically
+//! ([`super::write_atomic`]).
 //!
 //! Text is rendered from the TrueType file [`FONT_PATH`] (Debian package `fonts-dejavu-core`),
-//! read at run time and registered with plotters; the option `-ehl_plot_font FILE`
-//! ([`set_font_file`]) names another. If the font cannot be read every plot function fails
-//! with an error naming the package.
+//! read at run time; the option `-ehl_plot_font FILE` ([`set_font_file`]) names another. If the
+//! font cannot be read every plot function fails with an error naming the package.
 //!
 //! All input must be finite (and positive on a log axis); otherwise the functions return `Err`.
+use ab_glyph::{Font, FontVec, PxScale, ScaleFont};
 use std::path::Path;
 use std::sync::OnceLock;
 
 /// The TrueType font used for all text in plots.
 pub const FONT_PATH: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
-static FONT: OnceLock<Result<(), String>> = OnceLock::new();
+static FONT: OnceLock<Result<FontVec, String>> = OnceLock::new();
 static FONT_FILE: OnceLock<String> = OnceLock::new();
 
 /// Uses the TrueType font `path` instead of [`FONT_PATH`] (before the first plot; later
@@ -31,29 +27,28 @@ pub fn set_font_file(path: &str) {
     let _ = FONT_FILE.set(path.to_string());
 }
 
-/// Reads the font file and registers it with plotters as its sans-serif font (plotters keeps
-/// fonts for the life of the process, so the bytes are leaked; this happens once).
-fn load_font(path: &str) -> Result<(), String> {
+fn load_font(path: &str) -> Result<FontVec, String> {
     let bytes = std::fs::read(path).map_err(|e| {
         format!(
             "plot font '{path}' cannot be read ({e}): install the Debian package fonts-dejavu-core \
              (apt-get install fonts-dejavu-core) or give -ehl_plot_font FILE, a TrueType font file"
         )
     })?;
-    let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
-    plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, bytes)
-        .map_err(|_| format!("plot font '{path}' is not a valid TrueType font"))
+    FontVec::try_from_vec(bytes).map_err(|_| format!("plot font '{path}' is not a valid TrueType font"))
+}
+
+fn font() -> Result<&'static FontVec, String> {
+    FONT.get_or_init(|| load_font(FONT_FILE.get().map_or(FONT_PATH, |f| f.as_str()))).as_ref().map_err(|e| e.clone())
 }
 
 /// Loads the plot font once (from [`set_font_file`] or [`FONT_PATH`]); every plot function calls it
 /// first, so a missing font is an error before any drawing.
 pub fn ensure_font() -> Result<(), String> {
-    FONT.get_or_init(|| load_font(FONT_FILE.get().map_or(FONT_PATH, |f| f.as_str()))).clone()
+    font().map(|_| ())
 }
 
 mod axes;
 mod canvas;
-mod chart;
 mod line;
 mod map;
 mod quiver;
@@ -63,7 +58,6 @@ mod tests;
 use axes::*;
 use canvas::*;
 pub use canvas::{blue_white_red, viridis};
-use chart::*;
 pub use line::line_plot;
 pub use map::map_plot;
 use map::*;

@@ -1,6 +1,5 @@
 //! Quiver (arrow) plots of a vector field.
 use super::*;
-use plotters::prelude::{BitMapBackend, ChartBuilder, IntoDrawingArea};
 
 pub(super) fn draw_arrow(cv: &mut Canvas, tail: (f64, f64), tip: (f64, f64), c: Rgb, width: f64, clip: BoxPx) {
     let (dx, dy) = (tip.0 - tail.0, tip.1 - tail.1);
@@ -64,51 +63,48 @@ pub fn quiver_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, arrows:
         None => 1.0,
     };
 
-    let (mut x, mut y) = (Axis::new(xr, false, 6), Axis::new(yr, false, 6));
-    let (left, bottom) = (y_area(&y, ylabel), x_area(xlabel));
-    let ref_row = text_size("0", TICK_SIZE).1 + 20;
     let (w, h) = (opts.width as i32, opts.height as i32);
-    let right = max_label_width(&x) / 2 + 25;
-    let avail = BoxPx { l: 15 + left, t: title_band(title), r: w - right, b: h - 15 - ref_row - bottom };
+    let mut x = Axis { lo: xr.0, hi: xr.1, log: false, p0: 0.0, p1: 1.0, target: 6 };
+    let mut y = Axis { lo: yr.0, hi: yr.1, log: false, p0: 1.0, p1: 0.0, target: 6 };
+    let label_h = text_size("Xg", LABEL_SIZE).1;
+    let tick_h = text_size("0", TICK_SIZE).1;
+    let left = 15 + if ylabel.is_empty() { 0 } else { label_h + 12 } + max_label_width(&y.ticks(), TICK_SIZE) + TICK_LEN + 5;
+    let right = max_label_width(&x.ticks(), TICK_SIZE) / 2 + 25;
+    let top = title_band(title);
+    let ref_row = tick_h + 20;
+    let bottom = TICK_LEN + 4 + tick_h + if xlabel.is_empty() { 0 } else { 10 + label_h } + 15 + ref_row;
+    let avail = BoxPx { l: left, t: top, r: w - right, b: h - bottom };
     if avail.r - avail.l < 50 || avail.b - avail.t < 50 {
         return Err(format!("quiver_plot: {w}x{h} pixels is too small for the labels"));
     }
     let min_w = text_size(title, TITLE_SIZE).0 + 40;
     let (bx, w, h) = fit_box(avail, xr, yr, opts.equal_aspect, w, h, min_w);
     let mut cv = Canvas::new(w as u32, h as u32)?;
-    let yy = (h - 15 - ref_row / 2) as f64 + 0.5; // reference arrow, bottom right under the plot
-    let bx = {
-        let root = BitMapBackend::with_buffer(&mut cv.buf, (w as u32, h as u32)).into_drawing_area();
-        title_text(&root, title)?;
-        let mut chart = ChartBuilder::on(&root)
-            .margin_top(bx.t)
-            .margin_left(bx.l - left)
-            .margin_right(w - bx.r)
-            .margin_bottom(h - bx.b - bottom)
-            .x_label_area_size(bottom)
-            .y_label_area_size(left)
-            .build_cartesian_2d(x.clone(), y.clone())
-            .map_err(pe)?;
-        let bx = draw_frame(&root, &mut chart, &mut x, &mut y, (xlabel, ylabel), false)?;
-        let len = scale * reference * x.scale();
-        let label = format!("{} {}", format_short(reference), opts.unit);
-        text(&root, label.trim(), ((bx.r as f64 - len).round() as i32 - 10, yy as i32), TICK_SIZE, (HPos::Right, VPos::Center))?;
-        root.present().map_err(pe)?;
-        bx
-    };
-    let ib = BoxPx { l: bx.l + 1, t: bx.t + 1, r: bx.r - 1, b: bx.b - 1 };
+    x.p0 = bx.l as f64;
+    x.p1 = bx.r as f64;
+    y.p0 = bx.b as f64;
+    y.p1 = bx.t as f64;
     let (sx, sy) = (x.scale(), y.scale()); // pixels per data unit (sy < 0)
     let color = (20, 40, 120);
     let width = if arrows.len() > 400 { 1.2 } else { 1.8 };
+
     if let Some(c) = opts.circle {
-        draw_circle(&mut cv, &x, &y, c, ib);
+        draw_circle(&mut cv, &x, &y, c, bx);
     }
     for a in arrows {
         let (cx, cy) = (x.px(a[0]), y.px(a[1]));
         let (dx, dy) = (0.5 * scale * a[2] * sx, 0.5 * scale * a[3] * sy);
-        draw_arrow(&mut cv, (cx - dx, cy - dy), (cx + dx, cy + dy), color, width, ib);
+        draw_arrow(&mut cv, (cx - dx, cy - dy), (cx + dx, cy + dy), color, width, bx);
     }
+    cv.text(title, w / 2, 15, TITLE_SIZE, HPos::Center, VPos::Top, false);
+    draw_frame(&mut cv, bx, &x, &y, None, (xlabel, ylabel, ""));
+    // reference arrow, bottom right under the plot
+    let len = scale * reference * sx;
+    let yy = (h - 15 - ref_row / 2) as f64 + 0.5;
+    let x1 = bx.r as f64;
     let full = cv.full();
-    draw_arrow(&mut cv, (bx.r as f64 - scale * reference * sx, yy), (bx.r as f64, yy), color, 1.8, full);
+    draw_arrow(&mut cv, (x1 - len, yy), (x1, yy), color, 1.8, full);
+    let label = format!("{} {}", format_short(reference), opts.unit);
+    cv.text(label.trim(), (x1 - len).round() as i32 - 10, yy as i32, TICK_SIZE, HPos::Right, VPos::Center, false);
     cv.save(path)
 }
