@@ -109,10 +109,13 @@ fn sigint_to_mpirun_during_newton_ends_the_job_without_results() {
     // message; on a loaded machine the message can be lost in mpirun's teardown, and once
     // the solve had already finished and wrote its complete result. What must always hold:
     // mpirun ends non-zero, and the folder holds no temporary (half-written) file and
-    // either nothing or a complete result with its summary.json.
+    // either nothing or a complete result with its summary.json. A rank SIGKILLed by the
+    // teardown cannot remove its lock and staging folder: the next run in the folder takes
+    // the stale lock over and removes them (unit test in src/output), so they are allowed.
     let (code, stderr, out) = interrupt_run("fault-sigint-mpirun", "Newton from the Hertz start", libc::SIGINT, Target::Mpirun);
     assert_ne!(code, Some(0), "{stderr}");
-    let files = files_in(&out);
+    let killed = |f: &String| f == ".ehl-petsc.lock" || f.starts_with(".partial-");
+    let files: Vec<String> = files_in(&out).into_iter().filter(|f| !killed(f)).collect();
     assert!(files.iter().all(|f| !f.contains(".tmp-")), "half-written files: {files:?}");
     assert!(files.is_empty() || files.iter().any(|f| f == "summary.json"), "results without a summary: {files:?}");
 }

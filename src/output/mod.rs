@@ -107,7 +107,11 @@ pub fn claim_output_dir(dir: &Path) -> Result<OutputClaim, String> {
                         claim.lock.display()
                     ));
                 }
-                // A stale lock (its process has ended): take it over.
+                // A stale lock (its process has ended, e.g. SIGKILLed by mpirun's
+                // teardown): take it over, with what that process left half-done.
+                if let Some(pid) = pid {
+                    remove_leftovers(dir, pid);
+                }
                 let _ = std::fs::remove_file(&claim.lock);
             }
             Err(e) => {
@@ -117,6 +121,20 @@ pub fn claim_output_dir(dir: &Path) -> Result<OutputClaim, String> {
         }
     }
     Err(format!("output folder '{}': cannot take its lock file {}", dir.display(), claim.lock.display()))
+}
+
+/// Removes what a killed run with process id `pid` left in `dir`: its staging folder
+/// (`.partial-PID`, results not yet published) and its temporary files (`.NAME.tmp-PID`).
+/// Nothing of another process is touched.
+fn remove_leftovers(dir: &Path, pid: u32) {
+    let _ = std::fs::remove_dir_all(dir.join(format!(".partial-{pid}")));
+    let suffix = format!(".tmp-{pid}");
+    for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.starts_with('.') && name.ends_with(&suffix) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
 }
 
 impl OutputClaim {
@@ -166,5 +184,31 @@ pub fn peak_rss_mb() -> f64 {
         usage.ru_maxrss as f64 / 1024.0
     } else {
         f64::NAN
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_stale_lock_is_taken_over_with_the_dead_runs_leftovers_and_nothing_else() {
+        let dir = std::env::temp_dir().join(format!("ehl-claim-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join(".partial-999999999")).unwrap();
+        std::fs::write(dir.join(".partial-999999999/film_map.png"), b"x").unwrap();
+        std::fs::write(dir.join(".summary.json.tmp-999999999"), b"{").unwrap();
+        std::fs::write(dir.join(".summary.json.tmp-1"), b"{").unwrap();
+        std::fs::write(dir.join("summary.json"), b"{}").unwrap();
+        // Process 999999999 is above Linux's largest pid (2^22): it does not exist.
+        std::fs::write(dir.join(LOCK_FILE), format!("999999999 {}\n", host_name())).unwrap();
+        let claim = claim_output_dir(&dir).unwrap();
+        let mut left: Vec<String> =
+            std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        left.sort();
+        assert_eq!(left, [".ehl-petsc.lock", ".summary.json.tmp-1", "summary.json"]);
+        claim.release(true);
+        assert!(!dir.join(LOCK_FILE).exists());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
