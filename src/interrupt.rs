@@ -42,9 +42,35 @@ pub fn install() {
     }
 }
 
+/// The agreed "signal" of a spent time budget ([`set_deadline`]). SIGHUP's number: it is not
+/// handled here, and any real signal (SIGINT 2, SIGTERM 15) outranks it in the reduction.
+pub const DEADLINE: i32 = 1;
+
+/// The time budget's end (None: no budget).
+static END: std::sync::Mutex<Option<std::time::Instant>> = std::sync::Mutex::new(None);
+
+/// Sets (or clears) the time budget: from `end` on, every collective check stops the run
+/// as a signal would, with [`DEADLINE`] agreed. The caller decides what a spent budget
+/// means (the adaptive loop writes its last converged level).
+pub fn set_deadline(end: Option<std::time::Instant>) {
+    *END.lock().unwrap_or_else(|e| e.into_inner()) = end;
+}
+
+/// Forgets a spent budget once its caller has handled it (the budget itself is cleared
+/// too), so that the checks of what follows (writing the result) pass.
+pub fn clear_deadline() {
+    set_deadline(None);
+    let _ = AGREED.compare_exchange(DEADLINE, 0, Ordering::SeqCst, Ordering::SeqCst);
+}
+
+fn deadline_passed() -> bool {
+    END.lock().unwrap_or_else(|e| e.into_inner()).is_some_and(|end| std::time::Instant::now() >= end)
+}
+
 /// Name of a signal for messages.
 pub fn signal_name(sig: i32) -> String {
     match sig {
+        DEADLINE => "the time budget accuracy.max_seconds".into(),
         libc::SIGINT => "SIGINT".into(),
         libc::SIGTERM => "SIGTERM".into(),
         s => format!("signal {s}"),
@@ -59,7 +85,10 @@ pub fn message(sig: i32, during: &str) -> String {
 /// Collective over MPI_COMM_WORLD (PETSc's world communicator): the largest signal number any rank received (0 if
 /// none). Every rank must call it at the same point.
 pub fn collective_signal() -> i32 {
-    let local = LOCAL.load(Ordering::SeqCst);
+    let mut local = LOCAL.load(Ordering::SeqCst);
+    if local == 0 && deadline_passed() {
+        local = DEADLINE;
+    }
     let mut all: i32 = 0;
     // SAFETY: plain MPI reduction of one int over the world communicator, which PETSc and
     // every rank share; called collectively.

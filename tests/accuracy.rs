@@ -91,3 +91,20 @@ fn a_level_over_the_unknowns_budget_is_not_solved_and_the_run_says_so() {
     assert_eq!(s["film"]["hc_m"], acc["levels"][1]["hc_m"], "{s}");
     assert!(acc["estimated_error"]["hc"].as_f64().unwrap() > 0.0, "{acc}");
 }
+
+/// A time budget spent during a level abandons that level on every rank: the last converged
+/// level's result is written, labelled with the reason, and the run exits 4. With a budget
+/// of 1 s the first level (which always runs to its end) has spent it, so level 1 stops at
+/// its first check and level 0's film is the result.
+#[test]
+fn a_spent_time_budget_writes_the_last_converged_level_and_says_so() {
+    let (out, s) = moes_m10("accuracy_time_budget", "accuracy.max_seconds=1");
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(4), "{log}");
+    assert!(log.contains("accuracy.max_seconds = 1 s was spent during level 1") && log.contains("not reached"), "{log}");
+    assert!(!log.contains("interrupted"), "{log}");
+    let acc = &s["accuracy"];
+    assert_eq!(acc["reached"], false, "{acc}");
+    assert_eq!(acc["levels"].as_array().unwrap().len(), 1, "{acc}");
+    assert_eq!(s["film"]["hc_m"], acc["levels"][0]["hc_m"], "{s}");
+}

@@ -233,14 +233,20 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let growth = scene.mesh.growth;
     for k in 0..=max_levels {
         let t0 = Instant::now();
-        let setup = Setup::with_size_field(ctx, scene, field.clone())?;
+        let setup = match Setup::with_size_field(ctx, scene, field.clone()) {
+            Ok(s) => s,
+            Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
+        };
         let (n_u, n_p) = setup.layout.counts();
         if let (Some(prev), true) = (&previous, (n_u + n_p + 1) as u64 > acc.max_unknowns) {
             let why = format!("level {k} would have {} unknowns, above accuracy.max_unknowns = {}", n_u + n_p + 1, acc.max_unknowns);
             let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
             return finish(ctx, scene, prev, target, &levels, Some(why));
         }
-        let solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
+        let solver = match EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half) {
+            Ok(s) => s,
+            Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
+        };
         let sol = match (&previous, earlier) {
             (Some(prev), _) => {
                 let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
@@ -263,7 +269,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         drop(solver);
                         return finish(ctx, scene, prev, target, &levels, Some(why));
                     }
-                    Err(e) => return Err(e),
+                    Err(e) => {
+                        drop(solver);
+                        return out_of_time(ctx, scene, Some(prev), k, &levels, e);
+                    }
                 }
             }
             (None, Some(e)) => e.solve(ctx, scene, &solver)?,
@@ -291,6 +300,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             est: None,
         };
         levels.push(level);
+        if k == 0 && acc.max_seconds > 0.0 {
+            // The budget covers the levels after the first: a run always has a result.
+            crate::interrupt::set_deadline(Some(ctx.start + std::time::Duration::from_secs_f64(acc.max_seconds)));
+        }
         let est = Estimate::of(&levels);
         let level = levels.last_mut().expect("the level just pushed");
         level.est = est;
@@ -328,10 +341,28 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
         field = Some(Arc::new(next_field(&here.setup.mesh, &edges, &marked, growth)));
+        if let Err(e) = crate::interrupt::check("adaptive refinement") {
+            return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
+        }
         previous = Some(here);
-        crate::interrupt::check("adaptive refinement")?;
     }
     unreachable!("the loop returns at max_levels")
+}
+
+/// After level `k` stopped with `e`: when the time budget was spent (and a level converged
+/// before), the last converged level's result, labelled as short of its target; any other
+/// error (a signal, a failure outside Newton) stops the run.
+fn out_of_time(ctx: &Context, scene: &Scene, prev: Option<&Solved>, k: usize, levels: &[Level], e: String) -> Result<(), String> {
+    match prev {
+        Some(prev) if crate::interrupt::agreed() == crate::interrupt::DEADLINE => {
+            crate::interrupt::clear_deadline();
+            let acc = scene.accuracy;
+            let why = format!("the time budget accuracy.max_seconds = {} s was spent during level {k}", acc.max_seconds);
+            let why = short_of(acc.target, &why, k - 1, levels.last().and_then(|l| l.est));
+            finish(ctx, scene, prev, acc.target, levels, Some(why))
+        }
+        _ => Err(e),
+    }
 }
 
 /// The triangles the next level halves: Doerfler marking of the indicators plus the whole
@@ -380,6 +411,8 @@ fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<[f64; 2
 /// Writes the result of `done` (the last level solved) with the accuracy report; with a
 /// `shortfall` the report says the target was not reached and the run exits 4.
 fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Level], shortfall: Option<String>) -> Result<(), String> {
+    // The budget bounds the refinement, not the writing of its result.
+    crate::interrupt::clear_deadline();
     crate::interrupt::check("the Newton solve")?;
     ctx.write_results(|dir| {
         post_point(ctx, scene, &done.setup, &done.sol, done.condensation_s, dir)?;

@@ -137,7 +137,8 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
                 eprintln!("ehl-petsc: error{}: {e}", if all_failed { String::new() } else { format!(" (rank {rank})") });
             }
             match crate::interrupt::agreed() {
-                0 => 1,
+                // A spent time budget that nothing turned into a labelled result.
+                0 | crate::interrupt::DEADLINE => 1,
                 sig => 128 + sig,
             }
         }

@@ -228,11 +228,21 @@ pub struct Accuracy {
     /// Most unknowns a level may have: a level that would exceed it is not solved, and the
     /// last level's result is written with its estimated error (exit 4); default 600,000.
     pub max_unknowns: u64,
+    /// Wall-time budget of the refinement levels after the first, in seconds from the start
+    /// of the run: a level still running when it is spent is abandoned and the last
+    /// converged level's result is written with its estimated error (exit 4); 0: no
+    /// budget; default 1800.
+    pub max_seconds: f64,
 }
 
 /// Default of `accuracy.max_unknowns`: about 6.5 GB per rank on 2 ranks with MUMPS (the
 /// peak of a level grows like its unknowns to the power 1.2-1.4).
 pub const DEFAULT_MAX_UNKNOWNS: u64 = 600_000;
+
+/// Default of `accuracy.max_seconds`: four times the slowest Moes point that reaches 0.01 on
+/// 2 ranks (M = 200, L = 10: 472 s); the points that do not (M = 1000, L = 10) spend hours on
+/// levels whose Newton needs the continuation.
+pub const DEFAULT_MAX_SECONDS: f64 = 1800.0;
 
 /// Element size growth of a mesh refined adaptively by default (no `[mesh]` table): the
 /// solid under the refined face coarsens by one element size per unit depth.
@@ -262,7 +272,7 @@ pub const SUBSURFACE_CORE_DEPTH: f64 = 0.25;
 impl Default for Accuracy {
     fn default() -> Self {
         // target < 0: not given (the parser fills it in).
-        Accuracy { target: -1.0, max_levels: 8, marking: 0.5, max_unknowns: DEFAULT_MAX_UNKNOWNS }
+        Accuracy { target: -1.0, max_levels: 8, marking: 0.5, max_unknowns: DEFAULT_MAX_UNKNOWNS, max_seconds: DEFAULT_MAX_SECONDS }
     }
 }
 
@@ -297,6 +307,14 @@ pub const ACCURACY_FIELDS: &[Field] = &[
         Kind::Number(Range::Closed(1e4, 1e9)),
         Presence::Default("600000"),
         note = "a level that would exceed it is not solved: the last level's result is written with its estimated error, summary.json says accuracy.reached = false, and the exit code is 4 (about 6.5 GB per rank on 2 ranks at 600,000; raise it on a larger machine)"
+    ),
+    f!(
+        "max_seconds",
+        "wall-time budget of the refinement levels after the first, from the start of the run; 0: none",
+        "s",
+        Kind::Number(Range::Closed(0.0, 1e7)),
+        Presence::Default("1800"),
+        note = "a level still running when the budget is spent is abandoned on every rank at its next check: the last converged level's result is written with its estimated error, summary.json says accuracy.reached = false, and the exit code is 4; the first level always runs to its end"
     ),
 ];
 
