@@ -1,18 +1,19 @@
 //! Making failures collective: an error on one rank must end every rank cleanly,
 //! never leave the others waiting in a collective call.
+use crate::error::Error;
 use mpi::collective::SystemOperation;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 
 /// Every rank passes its local outcome; all ranks get `Ok` only if all succeeded. The
-/// failing ranks keep their own message; the others learn that a peer failed.
-pub fn agree<T>(world: &SimpleCommunicator, local: Result<T, String>) -> Result<T, String> {
+/// failing ranks keep their own error; the others get [`Error::PeerFailed`].
+pub fn agree<T>(world: &SimpleCommunicator, local: Result<T, Error>) -> Result<T, Error> {
     let flag: i32 = if local.is_ok() { 1 } else { 0 };
     let mut all: i32 = 0;
     world.all_reduce_into(&flag, &mut all, SystemOperation::min());
     match local {
         Ok(v) if all == 1 => Ok(v),
-        Ok(_) => Err("another MPI rank failed (see its message above)".into()),
+        Ok(_) => Err(Error::PeerFailed),
         Err(e) => Err(e),
     }
 }

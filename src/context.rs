@@ -2,6 +2,7 @@
 //! writes every part of the program makes through it. Below `app` so that the solver's
 //! modules can log and agree without depending on the program.
 use crate::collective;
+use crate::error::{Error, IoAction};
 use mpi::topology::SimpleCommunicator;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -31,7 +32,7 @@ impl Context {
 impl Context {
     /// Writes summary.json into the output folder (rank 0 calls it, once, after success;
     /// atomically, so a failed run leaves no summary behind).
-    pub fn write_summary(&self, summary: &serde_json::Value) -> Result<(), String> {
+    pub fn write_summary(&self, summary: &serde_json::Value) -> Result<(), Error> {
         self.write_summary_to(&self.out_dir.clone(), summary)
     }
 
@@ -40,7 +41,7 @@ impl Context {
     /// rank checks for an interruption together, and only then rank 0 moves the files into
     /// the output folder. A failure or a signal before that leaves no result file.
     /// Collective.
-    pub fn write_results<T>(&self, write: impl FnOnce(&std::path::Path) -> Result<T, String>) -> Result<T, String> {
+    pub fn write_results<T>(&self, write: impl FnOnce(&std::path::Path) -> Result<T, Error>) -> Result<T, Error> {
         let staging = self.out_dir.join(format!(".partial-{}", std::process::id()));
         self.create_dir(&staging)?;
         let written = collective::agree(&self.world, write(&staging));
@@ -64,24 +65,23 @@ impl Context {
     }
 
     /// Creates the output subfolder `dir` (rank 0; the outcome is shared). Collective.
-    pub fn create_dir(&self, dir: &std::path::Path) -> Result<(), String> {
-        let made =
-            if self.rank == 0 { std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display())) } else { Ok(()) };
+    pub fn create_dir(&self, dir: &std::path::Path) -> Result<(), Error> {
+        let made = if self.rank == 0 { std::fs::create_dir_all(dir).map_err(Error::io(IoAction::Create, dir)) } else { Ok(()) };
         collective::agree(&self.world, made)
     }
 
     /// Writes summary.json into `dir` (atomically; see [`Context::write_summary`]).
-    pub fn write_summary_to(&self, dir: &std::path::Path, summary: &serde_json::Value) -> Result<(), String> {
+    pub fn write_summary_to(&self, dir: &std::path::Path, summary: &serde_json::Value) -> Result<(), Error> {
         let path = dir.join("summary.json");
         // serde_json writes a NaN or an infinity as null: a result with such a number is
         // never written, let alone marked converged.
         let mut bad = Vec::new();
         null_numbers(summary, "", &mut bad);
         if !bad.is_empty() {
-            return Err(format!("the result holds numbers that are not finite ({}); no result written", bad.join(", ")));
+            return Err(Error::numerical(format!("the result holds numbers that are not finite ({}); no result written", bad.join(", "))));
         }
-        let text = serde_json::to_string_pretty(summary).map_err(|e| e.to_string())?;
-        crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        let text = serde_json::to_string_pretty(summary).map_err(|e| Error::other(e.to_string()))?;
+        crate::output::write_atomic(&path, text.as_bytes()).map_err(Error::writing(&path))?;
         self.log(format!("wrote {}", path.display()));
         Ok(())
     }

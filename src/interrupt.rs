@@ -16,6 +16,7 @@
 //!
 //! Installed after `PetscInitialize`, so it replaces PETSc's own handler for these two
 //! signals (which would abort without cleaning up). Exit code 128 + signal number.
+use crate::error::Error;
 use std::sync::atomic::{AtomicI32, Ordering};
 
 /// The signal this process received (0: none).
@@ -108,11 +109,12 @@ pub fn collective_signal() -> i32 {
     all
 }
 
-/// Collective check: `Err` with a clear message when any rank received a signal.
-pub fn check(during: &str) -> Result<(), String> {
+/// Collective check: [`Error::Interrupted`] with a clear message when any rank received a
+/// signal.
+pub fn check(during: &str) -> Result<(), Error> {
     match collective_signal() {
         0 => Ok(()),
-        sig => Err(message(sig, during)),
+        signal => Err(Error::Interrupted { signal, message: message(signal, during) }),
     }
 }
 

@@ -11,6 +11,7 @@
 //! - [`context`], [`collective`]: the run's shared state (rank, log, output folder) and
 //!   making an outcome agreed by every rank.
 //! - [`interrupt`]: SIGINT/SIGTERM, stopping every rank together.
+//! - [`error`]: the project's error type [`Error`], below every other module.
 //! - [`regress`]: summary.json comparison (regression runner) and the hard suite's checks.
 // `!(x > 0.0)` is written on purpose throughout: it rejects NaN as well as x <= 0.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -22,6 +23,7 @@ pub mod collective;
 pub mod context;
 pub mod ehl;
 pub mod ehl_options;
+pub mod error;
 pub mod fem;
 pub mod friction;
 pub mod interrupt;
@@ -32,3 +34,5 @@ pub mod physics;
 pub mod regress;
 pub mod reynolds;
 pub mod solid;
+
+pub use error::Error;

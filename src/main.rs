@@ -105,7 +105,7 @@ fn main() {
         .skip(1)
         .map(|a| a.into_string().unwrap_or_else(|a| usage_error(rank0, &format!("argument {a:?} is not valid UTF-8"))))
         .collect();
-    let split = cli::split(&args).unwrap_or_else(|e| usage_error(rank0, &e));
+    let split = cli::split(&args).unwrap_or_else(|e| usage_error(rank0, &e.to_string()));
     let cli = match Cli::try_parse_from(std::iter::once("ehl-petsc".to_string()).chain(split.ours)) {
         Ok(c) => c,
         Err(e) => {
@@ -126,7 +126,7 @@ fn main() {
         return;
     }
     if let Err(e) = cli::check_petsc_args(&split.petsc) {
-        usage_error(rank0, &e);
+        usage_error(rank0, &e.to_string());
     }
     let opts = ehl_petsc::app::RunOptions {
         scene: cli.scene.unwrap_or_else(|| usage_error(rank0, "no scene file given")),

@@ -22,6 +22,7 @@ use crate::case::Scene;
 use crate::collective;
 use crate::ehl::driver::{self, EhlSolution, EhlSolver, Start};
 use crate::ehl::post::FieldsOnFace;
+use crate::error::Error;
 use crate::mesh::size_field::SizeField;
 use crate::mesh::spec::dyadic_size;
 use crate::mesh::Mesh;
@@ -218,7 +219,7 @@ struct Solved {
 /// Collective. When the target cannot be reached (`max_levels`, `max_unknowns`, every
 /// triangle at the smallest size) the last level's result is written with its estimated
 /// error and `ctx.shortfall` says why (exit 4).
-pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<(), String> {
+pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<(), Error> {
     let acc = scene.accuracy;
     let target = acc.target;
     let max_levels = acc.max_levels as usize;
@@ -281,7 +282,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let fields = FieldsOnFace::new(&setup.mesh, &setup.layout, &sol.x);
         let st = fields.stats();
         if ![st.hc, st.hm, st.pmax].iter().all(|v| v.is_finite()) || st.hm <= 0.0 {
-            return Err(format!("accuracy: level {k} converged to an unphysical state (hc {}, hm {}); no result written", st.hc, st.hm));
+            return Err(Error::numerical(format!(
+                "accuracy: level {k} converged to an unphysical state (hc {}, hm {}); no result written",
+                st.hc, st.hm
+            )));
         }
         let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
         let edges = longest_edges(&setup.mesh);
@@ -352,7 +356,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
 /// After level `k` stopped with `e`: when the time budget was spent (and a level converged
 /// before), the last converged level's result, labelled as short of its target; any other
 /// error (a signal, a failure outside Newton) stops the run.
-fn out_of_time(ctx: &Context, scene: &Scene, prev: Option<&Solved>, k: usize, levels: &[Level], e: String) -> Result<(), String> {
+fn out_of_time(ctx: &Context, scene: &Scene, prev: Option<&Solved>, k: usize, levels: &[Level], e: Error) -> Result<(), Error> {
     match prev {
         Some(prev) if crate::interrupt::agreed() == crate::interrupt::DEADLINE => {
             crate::interrupt::clear_deadline();
@@ -400,7 +404,7 @@ fn describe(est: Option<Estimate>) -> String {
 
 /// The friction coefficients fx, fz of a level (every rank holds the whole iterate), or
 /// None without friction.
-fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<[f64; 2]>, String> {
+fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<[f64; 2]>, Error> {
     let visc = scene.viscosity_law().expect("lubricated scene");
     let eta = move |p: f64| visc.viscosity_and_derivative(p).0;
     let Some(fs) = super::lubricated::friction_setup(scene, &eta, fields.mesh.spec.contact) else { return Ok(None) };
@@ -410,7 +414,7 @@ fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<[f64; 2
 
 /// Writes the result of `done` (the last level solved) with the accuracy report; with a
 /// `shortfall` the report says the target was not reached and the run exits 4.
-fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Level], shortfall: Option<String>) -> Result<(), String> {
+fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Level], shortfall: Option<String>) -> Result<(), Error> {
     // The budget bounds the refinement, not the writing of its result.
     crate::interrupt::clear_deadline();
     crate::interrupt::check("the Newton solve")?;
@@ -435,10 +439,10 @@ fn add_accuracy_to_summary(
     target: f64,
     levels: &[Level],
     shortfall: Option<&str>,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    let mut summary: serde_json::Value = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text = std::fs::read_to_string(&path).map_err(Error::reading(&path))?;
+    let mut summary: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::format(format!("{}: {e}", path.display())))?;
     let last = levels.last().expect("a level");
     summary["accuracy"] = json!({
         "target": target,

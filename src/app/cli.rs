@@ -9,6 +9,7 @@
 //!   `-mat_mumps_cntl_1 -1`: a dash followed by a digit or a dot is a value);
 //! - everything after a bare `--` goes to PETSc unchanged;
 //! - exactly one other word, the scene file; a second one is an error naming it.
+use crate::error::Error;
 
 /// Our options that take a value, and those that do not.
 const WITH_VALUE: &[&str] = &["--output", "--set", "--start-from", "--convergence-study", "--ladder", "--first-size"];
@@ -29,7 +30,7 @@ fn is_petsc_option(w: &str) -> bool {
 }
 
 /// Splits the arguments (without the program name). Errors name the offending word.
-pub fn split(args: &[String]) -> Result<Split, String> {
+pub fn split(args: &[String]) -> Result<Split, Error> {
     let mut out = Split::default();
     let mut scene: Option<&str> = None;
     let mut i = 0;
@@ -43,15 +44,15 @@ pub fn split(args: &[String]) -> Result<Split, String> {
             let name = format!("--{}", body.split('=').next().unwrap_or(""));
             if FLAGS.contains(&name.as_str()) {
                 if body.contains('=') {
-                    return Err(format!("option '{name}' takes no value (found '{w}')"));
+                    return Err(Error::invalid(format!("option '{name}' takes no value (found '{w}')")));
                 }
                 out.ours.push(w.to_string());
             } else if WITH_VALUE.contains(&name.as_str()) {
                 out.ours.push(w.to_string());
                 if !body.contains('=') {
-                    let v = args.get(i + 1).ok_or_else(|| format!("option '{name}' needs a value"))?;
+                    let v = args.get(i + 1).ok_or_else(|| Error::invalid(format!("option '{name}' needs a value")))?;
                     if v.starts_with("--") {
-                        return Err(format!("option '{name}' needs a value (found the option '{v}'; write {name}=VALUE for a value that starts with two dashes)"));
+                        return Err(Error::invalid(format!("option '{name}' needs a value (found the option '{v}'; write {name}=VALUE for a value that starts with two dashes)")));
                     }
                     out.ours.push(v.clone());
                     i += 1;
@@ -60,7 +61,9 @@ pub fn split(args: &[String]) -> Result<Split, String> {
                 let hint = crate::case::spec::closest(&name, WITH_VALUE.iter().chain(FLAGS).copied())
                     .map(|c| format!(" (did you mean '{c}'?)"))
                     .unwrap_or_default();
-                return Err(format!("unknown option '{name}'{hint}; PETSc options take a single dash (e.g. -ksp_view) or follow '--'"));
+                return Err(Error::invalid(format!(
+                    "unknown option '{name}'{hint}; PETSc options take a single dash (e.g. -ksp_view) or follow '--'"
+                )));
             }
         } else if is_petsc_option(w) {
             out.petsc.push(w.to_string());
@@ -68,9 +71,9 @@ pub fn split(args: &[String]) -> Result<Split, String> {
                 if v.ends_with(".toml") && w != "-options_file" {
                     // A scene file, not a PETSc value: the first one is the scene.
                     if let Some(first) = scene {
-                        return Err(format!(
+                        return Err(Error::invalid(format!(
                             "unexpected argument '{v}' after the PETSc option '{w}': the scene file is already '{first}' (one scene per run)"
-                        ));
+                        )));
                     }
                 } else {
                     out.petsc.push(v.clone());
@@ -78,11 +81,11 @@ pub fn split(args: &[String]) -> Result<Split, String> {
                 }
             }
         } else if w == "-" || w.starts_with('-') {
-            return Err(format!("'{w}' is neither an option of ehl-petsc nor a PETSc option"));
+            return Err(Error::invalid(format!("'{w}' is neither an option of ehl-petsc nor a PETSc option")));
         } else if let Some(first) = scene {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "unexpected argument '{w}': the scene file is already '{first}' (one scene per run; PETSc options take a single dash)"
-            ));
+            )));
         } else {
             scene = Some(w);
             out.ours.push(w.to_string());
@@ -95,16 +98,16 @@ pub fn split(args: &[String]) -> Result<Split, String> {
 /// Checks what PETSc would otherwise fail on inside `PetscInitialize`, where a failure on
 /// one rank leaves the others waiting: the files of `-options_file` and
 /// `-options_file_yaml` must be readable regular files.
-pub fn check_petsc_args(petsc: &[String]) -> Result<(), String> {
+pub fn check_petsc_args(petsc: &[String]) -> Result<(), Error> {
     for (k, w) in petsc.iter().enumerate() {
         if w == "-options_file" || w == "-options_file_yaml" {
             let Some(f) = petsc.get(k + 1).filter(|v| !is_petsc_option(v)) else {
-                return Err(format!("PETSc option '{w}' needs a file name"));
+                return Err(Error::invalid(format!("PETSc option '{w}' needs a file name")));
             };
             match std::fs::metadata(f) {
                 Ok(m) if m.is_file() => {}
-                Ok(_) => return Err(format!("PETSc option '{w} {f}': not a regular file")),
-                Err(e) => return Err(format!("PETSc option '{w} {f}': {e}")),
+                Ok(_) => return Err(Error::invalid(format!("PETSc option '{w} {f}': not a regular file"))),
+                Err(e) => return Err(Error::invalid(format!("PETSc option '{w} {f}': {e}"))),
             }
         }
     }
@@ -143,18 +146,18 @@ mod tests {
 
     #[test]
     fn misuses_are_named() {
-        let e = split(&s(&["a.toml", "--sett", "x=1"])).unwrap_err();
+        let e = split(&s(&["a.toml", "--sett", "x=1"])).unwrap_err().to_string();
         assert!(e.contains("'--sett'") && e.contains("--set"), "{e}");
-        let e = split(&s(&["a.toml", "b.toml"])).unwrap_err();
+        let e = split(&s(&["a.toml", "b.toml"])).unwrap_err().to_string();
         assert!(e.contains("'b.toml'"), "{e}");
-        let e = split(&s(&["a.toml", "-ksp_view", "b.toml"])).unwrap_err();
+        let e = split(&s(&["a.toml", "-ksp_view", "b.toml"])).unwrap_err().to_string();
         assert!(e.contains("'b.toml'"), "{e}");
         let r = split(&s(&["-log_view", "a.toml", "-ksp_type", "cg"])).unwrap();
         assert_eq!((r.ours, r.petsc), (s(&["a.toml"]), s(&["-log_view", "-ksp_type", "cg"])));
-        let e = split(&s(&["a.toml", "--output"])).unwrap_err();
+        let e = split(&s(&["a.toml", "--output"])).unwrap_err().to_string();
         assert!(e.contains("'--output' needs a value"), "{e}");
-        let e = split(&s(&["a.toml", "--check=yes"])).unwrap_err();
+        let e = split(&s(&["a.toml", "--check=yes"])).unwrap_err().to_string();
         assert!(e.contains("'--check' takes no value"), "{e}");
-        assert!(split(&s(&["a.toml", "-"])).unwrap_err().contains("'-'"));
+        assert!(split(&s(&["a.toml", "-"])).unwrap_err().to_string().contains("'-'"));
     }
 }

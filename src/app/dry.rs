@@ -3,6 +3,7 @@
 //! the half-space solution (docs/model.md sections 2 and 6).
 use super::{collective, Context};
 use crate::case::Scene;
+use crate::error::{Error, ResultExt};
 use crate::mesh::{self, Mesh};
 use crate::petsc::{self, Ksp, Vector};
 use crate::solid::{assembly, dofmap::DofMap, hertz_load};
@@ -13,8 +14,8 @@ use std::time::Instant;
 const HERTZ_SPLIT_DEPTH: u32 = 6;
 
 /// Builds the mesh described by the scene (every rank builds the same mesh).
-pub fn build_mesh(scene: &Scene, half_z: bool) -> Result<Mesh, String> {
-    mesh::generate(&mesh_spec(scene, half_z)).map_err(|e| format!("mesh: {e}"))
+pub fn build_mesh(scene: &Scene, half_z: bool) -> Result<Mesh, Error> {
+    mesh::generate(&mesh_spec(scene, half_z)).context("mesh")
 }
 
 /// The mesh specification of the scene.
@@ -52,8 +53,8 @@ pub fn mesh_spec(scene: &Scene, half_z: bool) -> mesh::MeshSpec {
 }
 
 /// Value of the y displacement (dimensionless U) at (x, z) on the contact face.
-pub fn contact_uy(mesh: &Mesh, dofs: &DofMap, sol: &[f64], x: f64, z: f64) -> Result<f64, String> {
-    let (tri, bary) = mesh.locate_contact(x, z).ok_or_else(|| format!("point ({x}, {z}) is not on the contact face"))?;
+pub fn contact_uy(mesh: &Mesh, dofs: &DofMap, sol: &[f64], x: f64, z: f64) -> Result<f64, Error> {
+    let (tri, bary) = mesh.locate_contact(x, z).ok_or_else(|| Error::other(format!("point ({x}, {z}) is not on the contact face")))?;
     let nodes = mesh.contact_tris[tri];
     let vals = nodes.map(|n| {
         let d = dofs.node_dof[n as usize][1];
@@ -81,9 +82,8 @@ fn subsurface_stresses(
     ksp: &Ksp,
     main_solve_s: f64,
     dir: &std::path::Path,
-) -> Result<Option<serde_json::Value>, String> {
+) -> Result<Option<serde_json::Value>, Error> {
     use super::subsurface as sub;
-    let pe = |e: petsc::PetscError| e.to_string();
     let t0 = Instant::now();
     let disc = scene.disc_material();
     let mu = match scene.effects.surface_traction {
@@ -102,10 +102,10 @@ fn subsurface_stresses(
     let (u, cost) = if reuse {
         let rss0 = sub::current_rss_mb();
         let comm = petsc::comm_world();
-        let b = sub::assemble_face_traction(comm, mesh, part, dofs, ctx.rank, &load).map_err(pe)?;
-        let x = Vector::new(comm, dofs.local(ctx.rank)).map_err(pe)?;
-        ksp.solve(&b, &x).map_err(pe)?;
-        let sol = x.gather_all().map_err(pe)?;
+        let b = sub::assemble_face_traction(comm, mesh, part, dofs, ctx.rank, &load)?;
+        let x = Vector::new(comm, dofs.local(ctx.rank))?;
+        ksp.solve(&b, &x)?;
+        let sol = x.gather_all()?;
         let cost = sub::SolveCost {
             seconds: t0.elapsed().as_secs_f64(),
             rss_increase_mb: sub::current_rss_mb() - rss0,
@@ -150,8 +150,7 @@ fn subsurface_stresses(
     Ok(Some(obj))
 }
 
-pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
-    let pe = |e: petsc::PetscError| e.to_string();
+pub fn run(ctx: &Context, scene: &Scene) -> Result<(), Error> {
     let hertz = scene.hertz();
     let eq = scene.equivalent_solid();
     let comm = petsc::comm_world();
@@ -175,37 +174,32 @@ pub fn run(ctx: &Context, scene: &Scene) -> Result<(), String> {
     ));
 
     let t1 = Instant::now();
-    let k = assembly::assemble_stiffness(comm, &mesh, &part, &dofs, ctx.rank, eq.nu).map_err(pe)?;
+    let k = assembly::assemble_stiffness(comm, &mesh, &part, &dofs, ctx.rank, eq.nu)?;
     let factor = assembly::traction_factor(eq.nu);
-    let b =
-        assembly::assemble_pressure_load(comm, &mesh, &part, &dofs, ctx.rank, factor, &|v| hertz_load::hertz_p2_load(v, HERTZ_SPLIT_DEPTH))
-            .map_err(pe)?;
+    let b = assembly::assemble_pressure_load(comm, &mesh, &part, &dofs, ctx.rank, factor, &|v| {
+        hertz_load::hertz_p2_load(v, HERTZ_SPLIT_DEPTH)
+    })?;
     let assembly_s = t1.elapsed().as_secs_f64();
     crate::interrupt::check("the assembly")?;
     // Load check: the assembled traction sums to -factor * integral of P = -factor * 2 pi / 3.
     let load_num = {
-        let local = b.local_values().map_err(pe)?;
+        let local = b.local_values()?;
         collective::sum_f64(&ctx.world, local.iter().sum::<f64>())
     };
     let load_exact = -factor * 2.0 * std::f64::consts::PI / 3.0;
     let load_error_rel = (load_num - load_exact).abs() / load_exact.abs();
-    ctx.log(format!(
-        "assembly: {:.2} s, {:.0} non-zeros; traction load error {:.2e}",
-        assembly_s,
-        k.nonzeros().map_err(pe)?,
-        load_error_rel
-    ));
+    ctx.log(format!("assembly: {:.2} s, {:.0} non-zeros; traction load error {:.2e}", assembly_s, k.nonzeros()?, load_error_rel));
 
     let t2 = Instant::now();
-    petsc::ksp::set_direct_solver_defaults("").map_err(pe)?;
-    let ksp = Ksp::new(comm, &k).map_err(pe)?;
-    let x = Vector::new(comm, dofs.local(ctx.rank)).map_err(pe)?;
-    let its = ksp.solve(&b, &x).map_err(pe)?;
+    petsc::ksp::set_direct_solver_defaults("")?;
+    let ksp = Ksp::new(comm, &k)?;
+    let x = Vector::new(comm, dofs.local(ctx.rank))?;
+    let its = ksp.solve(&b, &x)?;
     let solve_s = t2.elapsed().as_secs_f64();
     crate::interrupt::check("the elastic solve")?;
     ctx.log(format!("solve: {:.2} s ({} KSP iteration(s))", solve_s, its));
 
-    let sol = x.gather_all().map_err(pe)?;
+    let sol = x.gather_all()?;
     let scale = hertz.a * hertz.a / scene.geometry.ball_radius; // U -> metres
     let u_c = contact_uy(&mesh, &dofs, &sol, 0.0, 0.0)?;
     let u_a = contact_uy(&mesh, &dofs, &sol, 1.0, 0.0)?;

@@ -7,6 +7,7 @@ use super::{collective, Context};
 use crate::case::{FrictionModel, Scene};
 use crate::ehl::driver::{self, EhlSolution, EhlSolver};
 use crate::ehl::{layout::Layout, post::FieldsOnFace};
+use crate::error::{Error, ResultExt};
 use crate::friction::pass::{friction_pass, stress_at, FaceSolution, FrictionResult, FrictionSetup};
 use crate::friction::shear::ShearLaw;
 use crate::mesh::{self, Mesh};
@@ -27,7 +28,7 @@ pub struct Setup {
 }
 
 impl Setup {
-    pub fn new(ctx: &Context, scene: &Scene) -> Result<Setup, String> {
+    pub fn new(ctx: &Context, scene: &Scene) -> Result<Setup, Error> {
         Self::with_size_field(ctx, scene, None)
     }
 
@@ -37,7 +38,7 @@ impl Setup {
         ctx: &Context,
         scene: &Scene,
         field: Option<std::sync::Arc<crate::mesh::size_field::SizeField>>,
-    ) -> Result<Setup, String> {
+    ) -> Result<Setup, Error> {
         let t0 = Instant::now();
         let half = scene.uses_half_domain();
         if half {
@@ -52,7 +53,7 @@ impl Setup {
         } else {
             let mut spec = super::dry::mesh_spec(scene, half);
             spec.size_field = field;
-            let m = mesh::generate(&spec).map_err(|e| format!("mesh: {e}"))?;
+            let m = mesh::generate(&spec).context("mesh")?;
             let p = mesh::partition(&m, ctx.size);
             (m, p)
         };
@@ -138,7 +139,7 @@ pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
     })
 }
 
-pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<(), String> {
+pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<(), Error> {
     let hertz = scene.hertz();
     ctx.log(format!("Hertz: a = {:.5e} m, p_H = {:.5e} Pa; lambda_bar = {:.4e}", hertz.a, hertz.ph, driver::lambda_bar(scene)));
     if let Some(zc) = scene.spin_pole_over_a() {
@@ -206,7 +207,7 @@ pub fn post_point(
     sol: &EhlSolution,
     condensation_s: Option<f64>,
     dir: &Path,
-) -> Result<PointResult, String> {
+) -> Result<PointResult, Error> {
     let t_post = Instant::now();
     let (mesh, layout) = (&setup.mesh, &setup.layout);
     let hertz = scene.hertz();
@@ -217,13 +218,13 @@ pub fn post_point(
     // A converged Newton can still hold an unphysical state: never report it as a result.
     // Every rank holds the whole iterate, so every rank reaches the same verdict.
     if sol.x.iter().any(|v| !v.is_finite()) || ![st.hc, st.hm, st.pmax, st.pmin, st.load].iter().all(|v| v.is_finite()) {
-        return Err("the converged state contains NaN or infinite values; no result written".into());
+        return Err(Error::numerical("the converged state contains NaN or infinite values; no result written"));
     }
     if st.hm <= 0.0 {
-        return Err(format!(
+        return Err(Error::numerical(format!(
             "the converged film is not positive everywhere (minimum H = {:.3e} at ({:.3}a, {:.3}a)); no result written",
             st.hm, st.hm_at[0], st.hm_at[1]
-        ));
+        )));
     }
     let hs = scene.scales().film_scale();
     let (a, ph) = (hertz.a, hertz.ph);
@@ -270,7 +271,7 @@ pub fn post_point(
         }
         None => None,
     };
-    let tau = |x: f64, z: f64| -> Result<Option<[f64; 2]>, String> {
+    let tau = |x: f64, z: f64| -> Result<Option<[f64; 2]>, Error> {
         match &fset {
             Some(fs) => stress_at(&fields, fs, x, z).transpose(),
             None => Ok(None),
@@ -278,7 +279,7 @@ pub fn post_point(
     };
     // The scene's Reynolds rectangle (a half-domain solve is mirrored by FieldsOnFace).
     let r = &crate::mesh::Rect { x0: scene.reynolds.x_min, x1: scene.reynolds.x_max, z0: scene.reynolds.z_min, z1: scene.reynolds.z_max };
-    let profile = |from: [f64; 2], to: [f64; 2]| -> Result<Vec<Vec<f64>>, String> {
+    let profile = |from: [f64; 2], to: [f64; 2]| -> Result<Vec<Vec<f64>>, Error> {
         let mut rows = Vec::new();
         for s in fields.profile(from, to, 601) {
             let mut row = vec![s[0] * a, s[1] * a, s[2] * ph, s[3] * hs];
@@ -323,7 +324,7 @@ pub fn post_point(
     // The nodal pressure a later run can start from (--start-from).
     let face_p = dir.join(super::restart::FACE_PRESSURE);
     crate::output::write_atomic(&face_p, super::restart::face_pressure_csv(mesh, &|n| fields.p_node(n), a, ph).as_bytes())
-        .map_err(|e| format!("cannot write {}: {e}", face_p.display()))?;
+        .map_err(Error::writing(&face_p))?;
     let hd = scene.hamrock_dowson();
     let (n_u, n_p) = layout.counts();
     let kin = scene.kinematics().expect("lubricated scene");
@@ -435,7 +436,7 @@ fn subsurface_point(
     sol: &EhlSolution,
     condensation_s: Option<f64>,
     dir: &Path,
-) -> Result<serde_json::Value, String> {
+) -> Result<serde_json::Value, Error> {
     use super::subsurface as sub;
     let t0 = Instant::now();
     let mesh = &setup.mesh;
@@ -444,7 +445,8 @@ fn subsurface_point(
     // The friction pass's nodal shear stresses (Pa) per contact triangle.
     let mut tau: Vec<Option<[[f64; 2]; 6]>> = vec![None; mesh.contact_tris.len()];
     if with_friction {
-        let f = friction.ok_or("effects.surface_traction = \"friction\" needs the friction pass (effects.friction)")?;
+        let f =
+            friction.ok_or_else(|| Error::invalid("effects.surface_traction = \"friction\" needs the friction pass (effects.friction)"))?;
         for (t, v) in &f.nodal {
             tau[*t] = Some(*v);
         }
@@ -519,14 +521,14 @@ fn subsurface_point(
     Ok(obj)
 }
 
-fn write_profiles(dir: &Path, name: &str, rows: &[Vec<f64>], with_tau: bool) -> Result<(), String> {
+fn write_profiles(dir: &Path, name: &str, rows: &[Vec<f64>], with_tau: bool) -> Result<(), Error> {
     let mut text = String::from(if with_tau { "x_m,z_m,p_pa,h_m,tau_yx_pa,tau_yz_pa\n" } else { "x_m,z_m,p_pa,h_m\n" });
     for r in rows {
         text.push_str(&r.iter().map(|v| format!("{v:e}")).collect::<Vec<_>>().join(","));
         text.push('\n');
     }
     let path = dir.join(name);
-    crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    crate::output::write_atomic(&path, text.as_bytes()).map_err(Error::writing(&path))
 }
 
 /// PNG maps of p and h on the Reynolds rectangle and PNG plots of the two centre-line
@@ -539,7 +541,7 @@ fn write_plots(
     hs: f64,
     prof_x0: &[Vec<f64>],
     prof_z0: &[Vec<f64>],
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let mesh = fields.mesh;
     use crate::output::plot::{line_plot, map_plot, LineOpts, MapOpts, Series, Style};
     let mut tris = Vec::new();
@@ -630,7 +632,7 @@ fn write_plots(
 /// VTU of the contact face (P2 triangles, coordinates in m): p, h, the normal
 /// displacement u2 and, with friction, the disc shear stress (averaged over the
 /// triangles sharing a node), for ParaView.
-fn write_face_vtu(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, friction: Option<&FrictionResult>) -> Result<(), String> {
+fn write_face_vtu(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, friction: Option<&FrictionResult>) -> Result<(), Error> {
     let mesh = fields.mesh;
     let mut id = vec![u32::MAX; mesh.nodes.len()];
     let mut points = Vec::new();
@@ -672,9 +674,7 @@ fn write_face_vtu(dir: &Path, fields: &FieldsOnFace, a: f64, ph: f64, hs: f64, f
         vtu_fields.push(Field { name: "tau_disc_pa", components: 3, values: &tau });
     }
     let path = dir.join("contact_face.vtu");
-    crate::output::write_atomic_with(&path, |t| {
-        write_vtu_single_type(t, &points, 22, &conn, &vtu_fields, &[]).map_err(|e| format!("cannot write {}: {e}", t.display()))
-    })
+    crate::output::write_atomic_with(&path, |t| write_vtu_single_type(t, &points, 22, &conn, &vtu_fields, &[]).map_err(Error::writing(t)))
 }
 
 /// The friction pass reads the EHL solution through [`FaceSolution`] (so `friction` does

@@ -10,9 +10,10 @@ pub mod study;
 pub mod subsurface;
 pub mod sweep;
 
-use crate::case::Scene;
+use crate::case::{Scene, SceneError, SceneErrorKind};
 pub use crate::collective;
 pub use crate::context::Context;
+use crate::error::{Error, ResultExt};
 use crate::petsc::Petsc;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
@@ -115,7 +116,7 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
         Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => {
             study::run(&ctx, &scene, n, opts.ladder, first_size, opts.study_sequence)
         }
-        Some(_) => Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into()),
+        Some(_) => Err(Error::invalid("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")")),
         None => simulate(&ctx, &scene, earlier.as_ref()),
     };
     let failed_here = result.is_err();
@@ -193,38 +194,39 @@ pub fn check(opts: &RunOptions, print: bool) -> i32 {
 /// What `run` checks before it touches the output folder: the scene (with its `--set`
 /// overrides), a convergence study's ladder (its first size returned), and the earlier run
 /// of `--start-from`.
-fn checked_inputs(opts: &RunOptions) -> Result<(Scene, f64, Option<restart::EarlierRun>), String> {
-    let scene = crate::case::load_scene_with(&opts.scene, &opts.overrides).map_err(|e| e.to_string())?;
+fn checked_inputs(opts: &RunOptions) -> Result<(Scene, f64, Option<restart::EarlierRun>), Error> {
+    let scene = crate::case::load_scene_with(&opts.scene, &opts.overrides)?;
     let file = opts.scene.display();
-    scene.plausibility().map_err(|e| format!("{file}: {e}"))?;
-    check_mesh(&scene).map_err(|e| format!("{file}: {e}"))?;
+    scene.plausibility().context(file.to_string())?;
+    check_mesh(&scene).context(file.to_string())?;
     let first_size = opts.first_size.unwrap_or(opts.ladder.default_first());
     if let Some(n) = opts.study_levels {
         if scene.effects.lubrication != crate::case::LubricationModel::Reynolds {
-            return Err("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")".into());
+            return Err(Error::invalid("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")"));
         }
         if scene.is_sweep() {
-            return Err("--convergence-study solves one operating point: remove [sweep] from the scene".into());
+            return Err(Error::invalid("--convergence-study solves one operating point: remove [sweep] from the scene"));
         }
         study::check_ladder(opts.ladder, first_size, n)?;
         for k in 0..n {
             let level = study::level_scene(&scene, opts.ladder, study::level_size(first_size, k));
-            check_mesh(&level).map_err(|e| format!("{file}: --convergence-study level {}: {e}", k + 1))?;
-            level.plausibility().map_err(|e| format!("{file}: --convergence-study level {}: {e}", k + 1))?;
+            check_mesh(&level).context(format!("{file}: --convergence-study level {}", k + 1))?;
+            level.plausibility().context(format!("{file}: --convergence-study level {}", k + 1))?;
         }
     }
     if opts.study_sequence && opts.study_levels.is_none() {
-        return Err("--sequence applies to --convergence-study N (a single solve takes --start-from DIR)".into());
+        return Err(Error::invalid("--sequence applies to --convergence-study N (a single solve takes --start-from DIR)"));
     }
     let earlier = match &opts.start_from {
         None => None,
-        Some(_) if opts.study_levels.is_some() => return Err("--start-from applies to one solve, not to a --convergence-study".into()),
-        Some(_) if scene.is_sweep() => return Err(
-            "--start-from applies to one operating point: the scene has a [sweep] (each sweep point already starts from the previous one)"
-                .into(),
-        ),
+        Some(_) if opts.study_levels.is_some() => {
+            return Err(Error::invalid("--start-from applies to one solve, not to a --convergence-study"))
+        }
+        Some(_) if scene.is_sweep() => return Err(Error::invalid(
+            "--start-from applies to one operating point: the scene has a [sweep] (each sweep point already starts from the previous one)",
+        )),
         Some(_) if scene.effects.lubrication != crate::case::LubricationModel::Reynolds => {
-            return Err("--start-from needs a lubricated scene (effects.lubrication = \"reynolds\")".into())
+            return Err(Error::invalid("--start-from needs a lubricated scene (effects.lubrication = \"reynolds\")"))
         }
         Some(dir) => Some(restart::EarlierRun::read(dir)?),
     };
@@ -233,7 +235,7 @@ fn checked_inputs(opts: &RunOptions) -> Result<(Scene, f64, Option<restart::Earl
 
 /// Checks that the mesher can build the scene's mesh (what it would refuse only after the
 /// solve has started), with messages naming the scene keys.
-pub fn check_mesh(scene: &Scene) -> Result<(), String> {
+pub fn check_mesh(scene: &Scene) -> Result<(), SceneError> {
     let half = scene.effects.lubrication == crate::case::LubricationModel::Reynolds && scene.uses_half_domain();
     let spec = dry::mesh_spec(scene, half);
     let h = crate::mesh::spec::dyadic_size(scene.mesh.contact_size);
@@ -247,11 +249,12 @@ pub fn check_mesh(scene: &Scene) -> Result<(), String> {
         if !on_grid(h) {
             // The largest size 16/2^k the edge is a multiple of.
             let fits = (0..=10).map(|k| 16.0 / f64::from(1u32 << k)).find(|&size| on_grid(size)).unwrap_or(crate::case::MIN_CONTACT_SIZE);
-            return Err(format!(
+            return Err(SceneErrorKind::Conflict(format!(
                 "{key} = {} is not a multiple of the contact element size {h} a (mesh.contact_size = {} rounded down to 16/2^k): the Reynolds rectangle's edges must lie on the contact grid (use mesh.contact_size <= {fits} or move the edge)",
                 crate::case::spec::fmt_num(v),
                 crate::case::spec::fmt_num(scene.mesh.contact_size),
-            ));
+            ))
+            .into());
         }
     }
     if scene.effects.elasticity == crate::case::ElasticityModel::Rigid
@@ -259,11 +262,11 @@ pub fn check_mesh(scene: &Scene) -> Result<(), String> {
     {
         return Ok(());
     }
-    spec.validate().map(|_| ()).map_err(|e| format!("the mesh of [mesh] and [reynolds] cannot be built ({}); check mesh.cube_size, mesh.contact_size and the reynolds.x_min/x_max/z_min/z_max rectangle", e.trim_start_matches("mesh spec: ")))
+    spec.validate().map(|_| ()).map_err(|e| SceneErrorKind::Conflict(format!("the mesh of [mesh] and [reynolds] cannot be built ({}); check mesh.cube_size, mesh.contact_size and the reynolds.x_min/x_max/z_min/z_max rectangle", e.to_string().trim_start_matches("mesh spec: "))).into())
 }
 
 /// Dispatches on what the scene asks to simulate.
-fn simulate(ctx: &Context, scene: &Scene, earlier: Option<&restart::EarlierRun>) -> Result<(), String> {
+fn simulate(ctx: &Context, scene: &Scene, earlier: Option<&restart::EarlierRun>) -> Result<(), Error> {
     for w in scene.warnings().into_iter().chain(scene.plausibility().unwrap_or_default()) {
         ctx.log(format!("warning: {w}"));
     }

@@ -1,6 +1,7 @@
 //! PNG plots of the friction pass and of the kinematics (paper Figs. 9-11): shear-stress
 //! maps and profile on the disc, and the surface velocity fields of ball and disc.
 use crate::ehl::post::FieldsOnFace;
+use crate::error::Error;
 use crate::friction::pass::FrictionResult;
 use crate::mesh::Rect;
 use crate::output::plot::{line_plot, map_plot, quiver_plot, LineOpts, MapOpts, QuiverOpts, Series, Style};
@@ -11,7 +12,7 @@ use std::path::Path;
 /// Maps of tau_yx and tau_yz on the disc (MPa, diverging colours) over the Hertz zone
 /// and its surroundings, and the profile of both along the line z = `z_line` (m), whose
 /// rows are (x, z, p, h, tau_yx, tau_yz) in SI units.
-pub fn friction_plots(dir: &Path, fields: &FieldsOnFace, f: &FrictionResult, a: f64, z_line: f64, line: &[Vec<f64>]) -> Result<(), String> {
+pub fn friction_plots(dir: &Path, fields: &FieldsOnFace, f: &FrictionResult, a: f64, z_line: f64, line: &[Vec<f64>]) -> Result<(), Error> {
     let mesh = fields.mesh;
     let (mut tris, mut tx, mut tz) = (Vec::new(), Vec::new(), Vec::new());
     for (t, vals) in &f.nodal {
@@ -64,7 +65,7 @@ pub fn friction_plots(dir: &Path, fields: &FieldsOnFace, f: &FrictionResult, a: 
 
 /// Arrow maps of the ball and disc surface velocities and of the sliding velocity
 /// (U_B - U_D, W_B - W_D) over the Hertz zone (paper Fig. 9).
-pub fn velocity_plots(dir: &Path, k: &Kinematics, a: f64, _rect: &Rect) -> Result<(), String> {
+pub fn velocity_plots(dir: &Path, k: &Kinematics, a: f64, _rect: &Rect) -> Result<(), Error> {
     const N: usize = 13;
     let grid = |f: &dyn Fn(f64, f64) -> [f64; 2]| -> Vec<[f64; 4]> {
         let mut out = Vec::new();

@@ -7,6 +7,7 @@
 //! checks that the file's nodes are that mesh's contact nodes, and interpolates the P2
 //! pressure. Everything is read and checked before the output folder is touched.
 use crate::case::Scene;
+use crate::error::Error;
 use crate::mesh::{ContactLocator, Mesh};
 use crate::output::summary::{DrySummary, Summary};
 use std::path::{Path, PathBuf};
@@ -41,33 +42,42 @@ pub struct EarlierRun {
 impl EarlierRun {
     /// Reads `dir/summary.json` and `dir/face_pressure.csv` and rebuilds the earlier mesh.
     /// Errors name the option, the file and what is wrong.
-    pub fn read(dir: &Path) -> Result<EarlierRun, String> {
-        let err = |what: String| format!("--start-from {}: {what}", dir.display());
+    pub fn read(dir: &Path) -> Result<EarlierRun, Error> {
+        let err = |e: Error| e.context(format!("--start-from {}", dir.display()));
         let summary_path = dir.join("summary.json");
         let text = crate::case::read_bounded(&summary_path, 16 << 20).map_err(|e| {
-            err(format!("cannot read {}: {e} (the folder of a converged lubricated run is expected)", summary_path.display()))
+            err(Error::invalid(format!(
+                "cannot read {}: {e} (the folder of a converged lubricated run is expected)",
+                summary_path.display()
+            )))
         })?;
         // Checked in the order a user can act on: the file is JSON, the scene it stores is
         // valid (it may have been edited), the run converged, then the rest of its fields.
         let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| err(format!("{} is not valid JSON: {e}", summary_path.display())))?;
+            serde_json::from_str(&text).map_err(|e| err(Error::format(format!("{} is not valid JSON: {e}", summary_path.display()))))?;
         if serde_json::from_value::<DrySummary>(value.clone()).is_ok() {
-            return Err(err("the earlier run is a dry (Hertz) run: it has no film to start from".into()));
+            return Err(err(Error::invalid("the earlier run is a dry (Hertz) run: it has no film to start from")));
         }
         let stored: Scene = serde_json::from_value(value["scene"].clone())
-            .map_err(|e| err(format!("{} holds no scene this version can read: {e}", summary_path.display())))?;
-        let bad_scene = |e: String| err(format!("the scene stored in {} is not valid: {e}", summary_path.display()));
-        stored.validate().map_err(|e| bad_scene(e.to_string()))?;
-        stored.plausibility().map_err(|e| bad_scene(e.to_string()))?;
+            .map_err(|e| err(Error::format(format!("{} holds no scene this version can read: {e}", summary_path.display()))))?;
+        let bad_scene = |e: crate::case::SceneError| {
+            err(Error::from(e).context(format!("the scene stored in {} is not valid", summary_path.display())))
+        };
+        stored.validate().map_err(bad_scene)?;
+        stored.plausibility().map_err(bad_scene)?;
         super::check_mesh(&stored).map_err(bad_scene)?;
         if value["converged"].as_bool() != Some(true) {
-            return Err(err(format!("{} is not the summary of a converged run (\"converged\" is not true)", summary_path.display())));
+            return Err(err(Error::invalid(format!(
+                "{} is not the summary of a converged run (\"converged\" is not true)",
+                summary_path.display()
+            ))));
         }
-        let summary = Summary::from_json(&text)
-            .map_err(|e| err(format!("{} is not the summary of a lubricated run this version can read: {e}", summary_path.display())))?;
+        let summary = Summary::from_json(&text).map_err(|e| {
+            err(e.context(format!("{} is not the summary of a lubricated run this version can read", summary_path.display())))
+        })?;
         let (scene, hc_m, half) = (summary.scene, summary.film.hc_m, summary.solver.half_domain);
         if !hc_m.is_finite() {
-            return Err(err(format!("{} has no finite film.hc_m", summary_path.display())));
+            return Err(err(Error::format(format!("{} has no finite film.hc_m", summary_path.display()))));
         }
         let mesh = if scene.effects.elasticity == crate::case::ElasticityModel::Rigid {
             crate::mesh::face::face_mesh(&super::dry::mesh_spec(&scene, half))?
@@ -75,16 +85,16 @@ impl EarlierRun {
             super::dry::build_mesh(&scene, half)?
         };
         let csv_path = dir.join(FACE_PRESSURE);
-        let csv = crate::case::read_bounded(&csv_path, 256 << 20).map_err(|e| err(format!("cannot read {}: {e}", csv_path.display())))?;
+        let csv = crate::case::read_bounded(&csv_path, 256 << 20).map_err(|e| err(Error::reading(&csv_path)(e)))?;
         let a = scene.hertz().a;
         let rows: Vec<&str> = csv.lines().skip(1).filter(|l| !l.trim().is_empty()).collect();
         if rows.len() != mesh.contact_nodes.len() {
-            return Err(err(format!(
+            return Err(err(Error::format(format!(
                 "{} has {} nodes, but the mesh of the earlier scene has {} contact nodes (written by another version of the mesher?)",
                 csv_path.display(),
                 rows.len(),
                 mesh.contact_nodes.len()
-            )));
+            ))));
         }
         let mut p_pa = vec![0.0; mesh.nodes.len()];
         for (k, (row, &n)) in rows.iter().zip(&mesh.contact_nodes).enumerate() {
@@ -92,13 +102,17 @@ impl EarlierRun {
                 .split(',')
                 .map(|w| w.trim().parse::<f64>())
                 .collect::<Result<_, _>>()
-                .map_err(|e| err(format!("{} line {}: {e}", csv_path.display(), k + 2)))?;
+                .map_err(|e| err(Error::format(format!("{} line {}: {e}", csv_path.display(), k + 2))))?;
             if v.len() != 3 || !v.iter().all(|x| x.is_finite()) {
-                return Err(err(format!("{} line {}: expected three finite numbers x_m,z_m,p_pa", csv_path.display(), k + 2)));
+                return Err(err(Error::format(format!(
+                    "{} line {}: expected three finite numbers x_m,z_m,p_pa",
+                    csv_path.display(),
+                    k + 2
+                ))));
             }
             let c = mesh.nodes[n as usize];
             if (v[0] / a - c[0]).abs() > 1e-9 || (v[1] / a - c[2]).abs() > 1e-9 {
-                return Err(err(format!(
+                return Err(err(Error::format(format!(
                     "{} line {}: node at ({:.6}a, {:.6}a), but the earlier mesh has its contact node there at ({:.6}a, {:.6}a) (written by another version of the mesher?)",
                     csv_path.display(),
                     k + 2,
@@ -106,7 +120,7 @@ impl EarlierRun {
                     v[1] / a,
                     c[0],
                     c[2]
-                )));
+                ))));
             }
             p_pa[n as usize] = v[2];
         }
@@ -121,7 +135,7 @@ impl EarlierRun {
         ctx: &super::Context,
         scene: &Scene,
         solver: &crate::ehl::driver::EhlSolver,
-    ) -> Result<crate::ehl::driver::EhlSolution, String> {
+    ) -> Result<crate::ehl::driver::EhlSolution, Error> {
         let hertz = scene.hertz();
         let (a, ph) = (hertz.a, hertz.ph);
         let p = |x: f64, z: f64| self.pressure_at(x * a, z * a) / ph;

@@ -16,6 +16,7 @@ use super::lubricated::{post_point, PointResult, Setup};
 use super::{collective, Context};
 use crate::case::Scene;
 use crate::ehl::driver::EhlSolver;
+use crate::error::Error;
 use crate::output::plot::{line_plot, LineOpts, Series, Style};
 use std::time::Instant;
 
@@ -29,12 +30,12 @@ pub enum Ladder {
 }
 
 impl std::str::FromStr for Ladder {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self, Error> {
         match s {
             "core" => Ok(Ladder::Core),
             "ring" => Ok(Ladder::Ring),
-            _ => Err(format!("--ladder {s:?} is not allowed: use \"core\" or \"ring\"")),
+            _ => Err(Error::invalid(format!("--ladder {s:?} is not allowed: use \"core\" or \"ring\""))),
         }
     }
 }
@@ -66,7 +67,7 @@ pub fn level_size(first: f64, k: usize) -> f64 {
 /// Checks a ladder of `levels` levels from size `first`: at least 2 levels, a first size
 /// the mesher can make exactly (16/2^k), and a finest level no finer than the mesher's
 /// smallest size.
-pub fn check_ladder(ladder: Ladder, first: f64, levels: usize) -> Result<(), String> {
+pub fn check_ladder(ladder: Ladder, first: f64, levels: usize) -> Result<(), Error> {
     // The core ladder refines the whole core square; the ring ladder only a band, which
     // the monolithic coupling solves one level finer (table2-ue2's narrow ring at
     // 0.0078 a).
@@ -75,18 +76,18 @@ pub fn check_ladder(ladder: Ladder, first: f64, levels: usize) -> Result<(), Str
         Ladder::Ring => crate::case::MIN_CONTACT_SIZE / 2.0,
     };
     if !(first.is_finite() && first > 0.0 && crate::mesh::spec::dyadic_size(first) == first && first <= 16.0) {
-        return Err(format!(
+        return Err(Error::invalid(format!(
             "--first-size {first}: the first level's {} size must be 16/2^k a (0.5, 0.25, 0.125, ...), at most 16",
             ladder.sized()
-        ));
+        )));
     }
     let finest = level_size(first, levels.max(1) - 1);
     if levels < 2 || finest < min * (1.0 - 1e-12) {
         let max = (first / min).log2().round() as usize + 1;
-        return Err(format!(
+        return Err(Error::invalid(format!(
             "--convergence-study {levels}: the number of levels must be in [2, {max}] for the {ladder:?} ladder from {first} a (the finest {} size allowed is {min} a)",
             ladder.sized()
-        ));
+        )));
     }
     Ok(())
 }
@@ -165,7 +166,7 @@ pub fn convergence(q: &[f64]) -> Option<Convergence> {
 
 struct Level {
     /// Why the level failed (None: converged).
-    failed: Option<String>,
+    failed: Option<Error>,
     h: f64,
     n_u: usize,
     n_p: usize,
@@ -185,9 +186,9 @@ struct Level {
 /// the ladder with [`check_ladder`] (app::run does, before any output is written).
 /// With `sequence`, each level after the first starts from the last converged level's
 /// pressure (mesh sequencing, see [`super::restart`]).
-pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f64, sequence: bool) -> Result<(), String> {
+pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f64, sequence: bool) -> Result<(), Error> {
     if scene.is_sweep() {
-        return Err("--convergence-study solves one operating point: remove [sweep] from the scene".into());
+        return Err(Error::invalid("--convergence-study solves one operating point: remove [sweep] from the scene"));
     }
     let mut rows: Vec<Level> = Vec::new();
     let mut last_converged: Option<std::path::PathBuf> = None;
@@ -259,7 +260,7 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
     }
     let ok = rows.iter().filter(|r| r.failed.is_none()).count();
     if ok < 2 {
-        return Err(format!("convergence study: only {ok} of {levels} levels converged; nothing to compare"));
+        return Err(Error::NotConverged(format!("convergence study: only {ok} of {levels} levels converged; nothing to compare")));
     }
     if ctx.rank == 0 {
         write_outputs(ctx, scene, &rows, sequence)?;
@@ -267,7 +268,7 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
     Ok(())
 }
 
-fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) -> Result<(), String> {
+fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) -> Result<(), Error> {
     // Failed levels are listed, then left out of the estimates (the ladder still halves h
     // between the converged levels, which follow each other).
     let failed: Vec<String> =
@@ -316,7 +317,7 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) ->
         csv.push('\n');
     }
     let path = ctx.out_dir.join("study.csv");
-    crate::output::write_atomic(&path, csv.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    crate::output::write_atomic(&path, csv.as_bytes()).map_err(Error::writing(&path))?;
     // Markdown
     let mut md = format!("# Convergence study: {} ({} ranks)\n\n| level | h (a) | elastic unknowns | pressure unknowns | coupling | Newton its | mesh + setup + Newton = total (s) | peak RSS/rank (MB) |", scene.name, ctx.size);
     for (name, _) in &quantities {
@@ -401,7 +402,7 @@ fn write_outputs(ctx: &Context, scene: &Scene, all: &[Level], sequence: bool) ->
         if extrapolated { "" } else { " (the reference is the finest level, which is not judged)" }
     ));
     let path = ctx.out_dir.join("study.md");
-    crate::output::write_atomic(&path, md.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    crate::output::write_atomic(&path, md.as_bytes()).map_err(Error::writing(&path))?;
     ctx.log(format!("convergence study written: {} and study.csv\n{md}", path.display()));
     // Plots: relative error against unknowns and against wall time (levels with a nonzero
     // error: the finest is the reference when there is no extrapolation).
@@ -470,14 +471,14 @@ mod tests {
         // The ladders' limits: 6 core levels from 0.5 a, 4 ring levels from 0.125 a, 3 from
         // 0.0625 a (the mesher's finest size is 1/64 a); a first size must be 16/2^k.
         assert!(check_ladder(Ladder::Core, 0.5, 6).is_ok());
-        assert!(check_ladder(Ladder::Core, 0.5, 7).unwrap_err().contains("[2, 6]"));
+        assert!(check_ladder(Ladder::Core, 0.5, 7).unwrap_err().to_string().contains("[2, 6]"));
         assert!(check_ladder(Ladder::Ring, 0.125, 4).is_ok());
         assert!(check_ladder(Ladder::Ring, 0.0625, 4).is_ok());
-        assert!(check_ladder(Ladder::Ring, 0.0625, 5).unwrap_err().contains("[2, 4]"));
+        assert!(check_ladder(Ladder::Ring, 0.0625, 5).unwrap_err().to_string().contains("[2, 4]"));
         assert!(check_ladder(Ladder::Ring, 0.0625, 1).is_err());
-        assert!(check_ladder(Ladder::Ring, 0.1, 3).unwrap_err().contains("--first-size 0.1"));
+        assert!(check_ladder(Ladder::Ring, 0.1, 3).unwrap_err().to_string().contains("--first-size 0.1"));
         assert!(check_ladder(Ladder::Ring, -1.0, 3).is_err());
-        assert_eq!("ring".parse::<Ladder>(), Ok(Ladder::Ring));
+        assert_eq!("ring".parse::<Ladder>().unwrap(), Ladder::Ring);
         // The ring ladder keeps the scene's mesh and sets the ring; the core ladder drops it.
         let mut scene = crate::case::parse_scene(include_str!("../../cases/paper/table2-ue2.toml"), "x").unwrap();
         scene.mesh.ring_size = 0.03125;
@@ -485,6 +486,6 @@ mod tests {
         assert_eq!((r.mesh.ring_size, r.mesh.core_size, r.mesh.contact_size), (0.0625, scene.mesh.core_size, scene.mesh.contact_size));
         let c = level_scene(&scene, Ladder::Core, 0.0625);
         assert_eq!((c.mesh.ring_size, c.mesh.core_size, c.mesh.contact_size), (0.0, 0.0625, 0.25));
-        assert!("rings".parse::<Ladder>().unwrap_err().contains("\"core\" or \"ring\""));
+        assert!("rings".parse::<Ladder>().unwrap_err().to_string().contains("\"core\" or \"ring\""));
     }
 }

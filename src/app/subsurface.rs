@@ -11,6 +11,7 @@
 //! a p_H / E_disc.
 #![allow(clippy::needless_range_loop)]
 use crate::case::StressRecovery;
+use crate::error::Error;
 use crate::fem::elasticity::lame;
 use crate::mesh::{partition, Mesh, Partition, Rect};
 use crate::output::vtu::{write_vtu_single_type, Field, VTK_QUADRATIC_TETRA};
@@ -100,8 +101,8 @@ pub const PREFIX: &str = "subsurface_";
 /// Solves the elastic problem of the disc (unit Young's modulus, Poisson ratio `nu`) under
 /// each face traction of `loads`, on this rank alone (one MUMPS Cholesky on
 /// PETSC_COMM_SELF, one back substitution per load). The cost covers the first load.
-pub fn solve_alone(mesh: &Mesh, nu: f64, loads: &[&FaceLoad]) -> Result<(Vec<NodeField>, SolveCost), String> {
-    let pe = |e: petsc::PetscError| format!("subsurface elastic solve: {e}");
+pub fn solve_alone(mesh: &Mesh, nu: f64, loads: &[&FaceLoad]) -> Result<(Vec<NodeField>, SolveCost), Error> {
+    let pe = |e: petsc::PetscError| Error::from(e).context("subsurface elastic solve");
     let t0 = Instant::now();
     let rss0 = current_rss_mb();
     let selfc = unsafe { ffi::RSMPI_COMM_SELF };
@@ -364,7 +365,7 @@ fn extremum_json(name: &str, e: &Extremum, a: f64, ph: f64, out: &mut serde_json
 
 /// Recovery, outputs and the `subsurface` object of summary.json (rank 0). `u`: per-node
 /// displacement of the elastic solve (unit Young's modulus, traction in units of p_H).
-pub fn recover_and_write(mesh: &Mesh, u: &[[f64; 3]], p: &Params, dir: &Path, log: &dyn Fn(String)) -> Result<serde_json::Value, String> {
+pub fn recover_and_write(mesh: &Mesh, u: &[[f64; 3]], p: &Params, dir: &Path, log: &dyn Fn(String)) -> Result<serde_json::Value, Error> {
     let t0 = Instant::now();
     let rec = Recovered::new(mesh, u, p.nu, &p.rect, p.method);
     let recovery_s = t0.elapsed().as_secs_f64();
@@ -407,7 +408,7 @@ pub fn recover_and_write(mesh: &Mesh, u: &[[f64; 3]], p: &Params, dir: &Path, lo
         }
     }
     let path = dir.join("subsurface_axis.csv");
-    crate::output::write_atomic(&path, csv.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    crate::output::write_atomic(&path, csv.as_bytes()).map_err(Error::writing(&path))?;
     if p.vtu {
         write_region_vtu(&rec, u, p, &dir.join("subsurface.vtu"))?;
     }
@@ -433,7 +434,7 @@ pub fn maxima_only(mesh: &Mesh, u: &[[f64; 3]], p: &Params) -> serde_json::Value
     serde_json::Value::Object(obj)
 }
 
-fn write_region_vtu(rec: &Recovered, u: &[[f64; 3]], p: &Params, path: &Path) -> Result<(), String> {
+fn write_region_vtu(rec: &Recovered, u: &[[f64; 3]], p: &Params, path: &Path) -> Result<(), Error> {
     let mesh = rec.mesh;
     let mut id = vec![u32::MAX; mesh.nodes.len()];
     let mut points = Vec::new();
@@ -466,13 +467,12 @@ fn write_region_vtu(rec: &Recovered, u: &[[f64; 3]], p: &Params, path: &Path) ->
         Field { name: "principal_pa", components: 3, values: &pr },
     ];
     crate::output::write_atomic_with(path, |t| {
-        write_vtu_single_type(t, &points, VTK_QUADRATIC_TETRA, &conn, &fields, &[])
-            .map_err(|e| format!("cannot write {}: {e}", t.display()))
+        write_vtu_single_type(t, &points, VTK_QUADRATIC_TETRA, &conn, &fields, &[]).map_err(Error::writing(t))
     })
 }
 
 /// PNG maps of von Mises and tau_xy on the sections z = 0 (x-y plane) and x = 0 (z-y plane).
-fn write_sections(rec: &Recovered, p: &Params, dir: &Path, vm: &Extremum, txy: &Extremum) -> Result<(), String> {
+fn write_sections(rec: &Recovered, p: &Params, dir: &Path, vm: &Extremum, txy: &Extremum) -> Result<(), Error> {
     use crate::output::plot::{map_plot, MapOpts};
     let ph_mpa = p.ph * 1e-6;
     let depth = 2.0_f64.min(REGION_DEPTH);

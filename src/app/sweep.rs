@@ -10,17 +10,18 @@ use super::lubricated::{post_point, PointResult, Setup};
 use super::{collective, Context};
 use crate::case::Scene;
 use crate::ehl::driver::EhlSolver;
+use crate::error::Error;
 use crate::output::plot::{line_plot, LineOpts, Series, Style};
 use std::time::Instant;
 
 /// One row of the sweep table.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct SweepRow {
     pub ue: f64,
     pub lambda_deg: f64,
     pub srr: f64,
     /// The point's numbers, or the reason it failed.
-    pub result: Result<PointResult, String>,
+    pub result: Result<PointResult, Error>,
     pub newton_iterations: usize,
     pub wall_s: f64,
 }
@@ -34,7 +35,7 @@ fn point_label(p: &Scene) -> String {
     )
 }
 
-pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> Result<(), String> {
+pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> Result<(), Error> {
     let points = scene.points();
     let n = points.len();
     ctx.log(format!("sweep: {n} operating points on one mesh"));
@@ -49,7 +50,11 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
         // Test hook (fault injection): -ehl_fail_point k makes point k fail as a
         // non-converged Newton would, to test that the sweep goes on and ends non-zero.
         let injected = crate::ehl_options::get().fail_point == Some(k + 1);
-        let solved = if injected { Err("injected failure (-ehl_fail_point)".to_string()) } else { solver.solve(ctx, p, prev.as_deref()) };
+        let solved = if injected {
+            Err(Error::NotConverged("injected failure (-ehl_fail_point)".into()))
+        } else {
+            solver.solve(ctx, p, prev.as_deref())
+        };
         let result = match solved {
             Ok(sol) => {
                 its = sol.newton_total;
@@ -75,7 +80,7 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
                 }
                 if crate::interrupt::agreed() != 0 {
                     // Interrupted: the completed points keep their folders and sweep.csv.
-                    return Err(e.clone());
+                    return result.map(|_| ());
                 }
             }
         }
@@ -112,12 +117,12 @@ pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> R
     if failed.is_empty() {
         Ok(())
     } else {
-        Err(format!("{} of {} sweep points failed: {} (reasons in sweep.csv)", failed.len(), n, failed.join(", ")))
+        Err(Error::NotConverged(format!("{} of {} sweep points failed: {} (reasons in sweep.csv)", failed.len(), n, failed.join(", "))))
     }
 }
 
 /// `sweep.csv`: one row per point, in sweep order.
-fn write_table(ctx: &Context, rows: &[SweepRow]) -> Result<(), String> {
+fn write_table(ctx: &Context, rows: &[SweepRow]) -> Result<(), Error> {
     let mut t = String::from(
         "point,ue_m_s,tilt_angle_deg,slide_to_roll,status,hc_m,hm_m,pmax_pa,load_error_rel,fx,fz,newton_iterations,wall_s,reason\n",
     );
@@ -136,11 +141,16 @@ fn write_table(ctx: &Context, rows: &[SweepRow]) -> Result<(), String> {
                 r.newton_iterations,
                 r.wall_s
             )),
-            Err(e) => t.push_str(&format!("{head},failed,,,,,,,{},{:.2},\"{}\"\n", r.newton_iterations, r.wall_s, e.replace('"', "'"))),
+            Err(e) => t.push_str(&format!(
+                "{head},failed,,,,,,,{},{:.2},\"{}\"\n",
+                r.newton_iterations,
+                r.wall_s,
+                e.to_string().replace('"', "'")
+            )),
         }
     }
     let path = ctx.out_dir.join("sweep.csv");
-    crate::output::write_atomic(&path, t.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    crate::output::write_atomic(&path, t.as_bytes()).map_err(Error::writing(&path))
 }
 
 /// Which operating parameter a plot runs along.
@@ -214,7 +224,7 @@ fn series_along(
 
 /// The sweep's PNG plots: film against each swept parameter with more than one value,
 /// h_lambda/h_90 when lambda = 90 deg is in the sweep, and fx, fz against SRR.
-fn sweep_plots(ctx: &Context, scene: &Scene, rows: &[SweepRow]) -> Result<(), String> {
+fn sweep_plots(ctx: &Context, scene: &Scene, rows: &[SweepRow]) -> Result<(), Error> {
     let sw = scene.sweep.clone().unwrap_or_default();
     let varied: Vec<Axis> =
         [(Axis::Speed, sw.entrainment_speed.as_ref()), (Axis::Tilt, sw.tilt_angle.as_ref()), (Axis::Srr, sw.slide_to_roll.as_ref())]
@@ -222,7 +232,7 @@ fn sweep_plots(ctx: &Context, scene: &Scene, rows: &[SweepRow]) -> Result<(), St
             .filter(|(_, l)| l.map_or(0, |v| v.len()) > 1)
             .map(|(a, _)| a)
             .collect();
-    let write = |name: &str, title: &str, xlabel: &str, ylabel: &str, series: Vec<Series>, log_x: bool| -> Result<(), String> {
+    let write = |name: &str, title: &str, xlabel: &str, ylabel: &str, series: Vec<Series>, log_x: bool| -> Result<(), Error> {
         if series.is_empty() {
             return Ok(());
         }
@@ -288,7 +298,7 @@ fn sweep_plots(ctx: &Context, scene: &Scene, rows: &[SweepRow]) -> Result<(), St
 
 /// Film profiles along x = 0 (paper Fig. 6): one plot per (Ue, SRR) with one curve per
 /// tilt angle, `sweep_profile_x0_ue<Ue>_srr<SRR>.png`.
-fn profiles_by_tilt(ctx: &Context, rows: &[SweepRow]) -> Result<(), String> {
+fn profiles_by_tilt(ctx: &Context, rows: &[SweepRow]) -> Result<(), Error> {
     let mut groups: Vec<(f64, f64)> = Vec::new();
     for r in rows {
         if !groups.contains(&(r.ue, r.srr)) {

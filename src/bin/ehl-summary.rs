@@ -6,6 +6,7 @@
 //!   ehl-summary get FILE.json KEY...        prints the values of dotted keys
 //!   ehl-summary hard OUTDIR CASE...         the hard suite's table (OUTDIR/hard.md); exit 1 on a failed check
 use clap::{Parser, Subcommand};
+use ehl_petsc::error::{Error, ResultExt};
 use ehl_petsc::regress::{self, hard, Tolerances};
 use std::path::{Path, PathBuf};
 
@@ -38,17 +39,16 @@ enum Cmd {
     Hard { outdir: PathBuf, cases: Vec<String> },
 }
 
-fn read_json(p: &Path) -> Result<serde_json::Value, String> {
-    let text = std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?;
-    serde_json::from_str(&text).map_err(|e| format!("{} is not valid JSON: {e}", p.display()))
+fn read_json(p: &Path) -> Result<serde_json::Value, Error> {
+    let text = std::fs::read_to_string(p).map_err(Error::reading(p))?;
+    serde_json::from_str(&text).map_err(|e| Error::format(format!("{} is not valid JSON: {e}", p.display())))
 }
 
-fn run(cli: Cli) -> Result<i32, String> {
+fn run(cli: Cli) -> Result<i32, Error> {
     match cli.cmd {
         Cmd::Compare { reference, new, tolerances, rel, label } => {
             let mut tol = match &tolerances {
-                Some(p) => Tolerances::parse(&std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?)
-                    .map_err(|e| format!("{}: {e}", p.display()))?,
+                Some(p) => Tolerances::parse(&std::fs::read_to_string(p).map_err(Error::reading(p))?).context(p.display().to_string())?,
                 None => Tolerances::uniform(1e-6),
             };
             if let Some(r) = rel {
@@ -72,7 +72,7 @@ fn run(cli: Cli) -> Result<i32, String> {
                     Some(regress::Leaf::Num(v)) => println!("{v:e}"),
                     Some(regress::Leaf::Text(s)) => println!("{s}"),
                     Some(v) => println!("{v}"),
-                    None => return Err(format!("{}: no key '{k}'", file.display())),
+                    None => return Err(Error::invalid(format!("{}: no key '{k}'", file.display()))),
                 }
             }
             Ok(0)
@@ -102,7 +102,7 @@ fn run(cli: Cli) -> Result<i32, String> {
             md.push_str(&format!("\n{} of {} cases pass every check.\n", cases.len() - n_failed, cases.len()));
             print!("{md}");
             let path = outdir.join("hard.md");
-            std::fs::write(&path, &md).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            std::fs::write(&path, &md).map_err(Error::writing(&path))?;
             Ok(if n_failed == 0 { 0 } else { 1 })
         }
     }

@@ -8,20 +8,21 @@
 //! not reproduce is printed as DIFFERS with its numbers (the model is not bent to fit);
 //! the exit code is non-zero only when an output is missing.
 use ehl_petsc::output::summary::Summary;
+use ehl_petsc::Error;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-type Res<T> = Result<T, String>;
+type Res<T> = Result<T, Error>;
 
 fn read(path: &Path) -> Res<String> {
-    std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))
+    std::fs::read_to_string(path).map_err(Error::reading(path))
 }
 
 /// A CSV file as rows of named columns (numbers where they parse).
 fn csv(path: &Path) -> Res<Vec<HashMap<String, String>>> {
     let text = read(path)?;
     let mut lines = text.lines();
-    let head: Vec<String> = lines.next().ok_or("empty csv")?.split(',').map(str::to_string).collect();
+    let head: Vec<String> = lines.next().ok_or_else(|| Error::format("empty csv"))?.split(',').map(str::to_string).collect();
     Ok(lines.map(|l| head.iter().cloned().zip(l.split(',').map(str::to_string)).collect()).collect())
 }
 
@@ -133,11 +134,11 @@ fn figs_4_6(dir: &Path) -> Res<()> {
     }
     // 2: the profile on x = 0.
     println!();
-    let a = summary(&s.point_dir(ues[0], 90.0, 0.0).ok_or("no lambda = 90 point")?)?.hertz.a_m;
+    let a = summary(&s.point_dir(ues[0], 90.0, 0.0).ok_or_else(|| Error::invalid("no lambda = 90 point"))?)?.hertz.a_m;
     let mut asym = Vec::new();
     for &u in &ues {
         let prof = |l: f64| -> Res<Vec<HashMap<String, String>>> {
-            csv(&s.point_dir(u, l, 0.0).ok_or(format!("no point Ue {u} lambda {l}"))?.join("profile_x0.csv"))
+            csv(&s.point_dir(u, l, 0.0).ok_or_else(|| Error::invalid(format!("no point Ue {u} lambda {l}")))?.join("profile_x0.csv"))
         };
         let p90 = prof(90.0)?;
         let hc90 = s.get(u, 90.0, 0.0, "hc_m");

@@ -20,6 +20,7 @@ pub mod plausible;
 pub mod schema;
 pub mod spec;
 
+use crate::error::Error;
 use std::path::Path;
 
 use serde::Deserialize;
@@ -539,7 +540,7 @@ impl Scene {
         Scales::from_hertz(&self.hertz())
     }
 
-    fn viscosity_law_unchecked(&self, l: &Lubricant) -> Result<ViscosityLaw, String> {
+    fn viscosity_law_unchecked(&self, l: &Lubricant) -> Result<ViscosityLaw, Error> {
         let alpha = l.pressure_viscosity.unwrap_or(0.0);
         Ok(match self.effects.viscosity {
             ViscosityModel::Constant => ViscosityLaw::Constant { eta_r: l.viscosity },

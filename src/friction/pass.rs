@@ -9,6 +9,7 @@
 //! zone included: the model has no film-fraction, so the full film is sheared there; its
 //! share is small because the viscosity is low and the film thick).
 use super::shear::{disc_shear_stress, FilmPoint, ShearLaw};
+use crate::error::Error;
 use crate::fem::geometry::AffineTri;
 use crate::fem::p2tri::{p2_tri_eval, p2_tri_eval_grad};
 use crate::mesh::spec::Rect;
@@ -100,7 +101,7 @@ impl TriFields {
     }
 
     /// The shear stress on the disc at barycentric point `b` (Pa).
-    fn stress(&self, s: &FrictionSetup, b: [f64; 3]) -> Result<[f64; 2], String> {
+    fn stress(&self, s: &FrictionSetup, b: [f64; 3]) -> Result<[f64; 2], Error> {
         let (v, p, h) = (&self.v, &self.p, &self.h);
         let (pv, hv, g) = (p2_tri_eval(p, b), p2_tri_eval(h, b), p2_tri_eval_grad(p, b, &self.geo.grad_bary));
         let (x, z) = ((0..3).map(|i| b[i] * v[i][0]).sum::<f64>(), (0..3).map(|i| b[i] * v[i][1]).sum::<f64>());
@@ -110,12 +111,12 @@ impl TriFields {
         // cavitation boundary is not a physical tension: the viscosity sees max(p, 0).
         let pa = pv.max(0.0) * s.ph;
         let pt = FilmPoint { eta: (s.eta)(pa), h: hv * s.hs, grad_p: [g[0] * s.ph / s.a, g[1] * s.ph / s.a], slide: [vel.du(), vel.dw()] };
-        disc_shear_stress(&s.law, &pt).map_err(|e| format!("friction pass at (x, z) = ({x:.4}a, {z:.4}a): {e}"))
+        disc_shear_stress(&s.law, &pt).map_err(|e| Error::numerical(format!("friction pass at (x, z) = ({x:.4}a, {z:.4}a): {e}")))
     }
 }
 
 /// Runs the pass over Omega_c (serial; call it on one rank).
-pub fn friction_pass(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<FrictionResult, String> {
+pub fn friction_pass(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<FrictionResult, Error> {
     let t0 = std::time::Instant::now();
     let mesh = fields.mesh();
     let (mut fx_n, mut fz_n, mut tau_max) = (0.0, 0.0, 0.0f64);
@@ -150,7 +151,7 @@ pub fn friction_pass(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<Fri
 
 /// The shear stress on the disc at (x, z) (units of a), or None outside the contact face.
 /// On a half domain a point z > 0 takes its mirror image's stress with tau_yz negated.
-pub fn stress_at(fields: &dyn FaceSolution, s: &FrictionSetup, x: f64, z: f64) -> Option<Result<[f64; 2], String>> {
+pub fn stress_at(fields: &dyn FaceSolution, s: &FrictionSetup, x: f64, z: f64) -> Option<Result<[f64; 2], Error>> {
     let (t, b) = fields.locate(x, z)?;
     let mirrored = fields.half() && z > 0.0;
     Some(TriFields::new(fields, t).stress(s, b).map(|v| if mirrored { [v[0], -v[1]] } else { v }))

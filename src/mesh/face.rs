@@ -2,16 +2,17 @@
 //! P2 triangulation of the Reynolds rectangle on the plane y = 0, with no tetrahedra and
 //! no elastic unknowns (every node is marked clamped, so the elastic dof map is empty).
 use super::{partition::morton_order, Mesh, MeshSpec, Partition};
+use crate::error::Error;
 
 /// Uniform grid of squares of size close to `spec.contact_size` (the rectangle's sides
 /// divided into whole numbers of cells), each cut into two triangles along alternating
 /// diagonals (a criss-cross-free "union jack" pattern keeps the mesh symmetric about the
 /// rectangle's centre lines), P2 mid-side nodes added.
-pub fn face_mesh(spec: &MeshSpec) -> Result<Mesh, String> {
+pub fn face_mesh(spec: &MeshSpec) -> Result<Mesh, Error> {
     let r = spec.contact;
     let h = spec.contact_size;
     if !(h > 0.0) || !(r.x1 > r.x0) || !(r.z1 > r.z0) {
-        return Err(format!("face mesh: bad rectangle {r:?} or element size {h}"));
+        return Err(Error::invalid(format!("face mesh: bad rectangle {r:?} or element size {h}")));
     }
     let nx = ((r.x1 - r.x0) / h).round().max(1.0) as usize;
     let nz = ((r.z1 - r.z0) / h).round().max(1.0) as usize;

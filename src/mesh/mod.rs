@@ -29,6 +29,7 @@ pub mod spec;
 #[cfg(test)]
 mod tests;
 
+use crate::error::Error;
 pub use locate::ContactLocator;
 pub use partition::{equal_blocks, morton3, partition, Partition};
 pub use quality::{quality, tet_quality, Quality};
@@ -67,7 +68,7 @@ pub struct Mesh {
 }
 
 /// Generates the mesh described by `spec` (validated first).
-pub fn generate(spec: &MeshSpec) -> Result<Mesh, String> {
+pub fn generate(spec: &MeshSpec) -> Result<Mesh, Error> {
     let h = spec.validate()?;
     Ok(assemble::assemble(refined_bisector(spec, h), spec, h))
 }

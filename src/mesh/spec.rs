@@ -2,6 +2,7 @@
 //! validation of all of it (including the coarse tensor grid breakpoints).
 //!
 //! All lengths are dimensionless, in units of the Hertz radius `a`.
+use crate::error::Error;
 
 /// Edge length of the coarse tensor-grid cells (units of `a`).
 pub const COARSE_CELL: f64 = 16.0;
@@ -153,7 +154,7 @@ impl MeshSpec {
     }
 
     /// Validates the spec; returns the actual contact size on success.
-    pub fn validate(&self) -> Result<f64, String> {
+    pub fn validate(&self) -> Result<f64, Error> {
         self.validate_scalars()?;
         let h = self.actual_contact_size();
         self.validate_rect(h)?;
@@ -161,12 +162,12 @@ impl MeshSpec {
     }
 
     /// Checks positivity / finiteness of the scalar parameters.
-    fn validate_scalars(&self) -> Result<(), String> {
+    fn validate_scalars(&self) -> Result<(), Error> {
         let pos = |name: &str, v: f64| {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(format!("mesh spec: {name} must be finite and > 0 (got {v})"))
+                Err(Error::invalid(format!("mesh spec: {name} must be finite and > 0 (got {v})")))
             }
         };
         pos("cube_edge", self.cube_edge)?;
@@ -176,22 +177,25 @@ impl MeshSpec {
         if let Some(r) = self.ring {
             pos("ring size", r.size)?;
             if !(r.inner.is_finite() && r.outer.is_finite() && r.inner >= 0.0 && r.outer > r.inner) {
-                return Err(format!("mesh spec: ring radii must satisfy 0 <= inner < outer (got inner {}, outer {})", r.inner, r.outer));
+                return Err(Error::invalid(format!(
+                    "mesh spec: ring radii must satisfy 0 <= inner < outer (got inner {}, outer {})",
+                    r.inner, r.outer
+                )));
             }
         }
         if let Some((r, size)) = self.patch {
             pos("patch size", size)?;
             if !r.is_proper() {
-                return Err(format!("mesh spec: patch rectangle {r:?} is empty or not finite"));
+                return Err(Error::invalid(format!("mesh spec: patch rectangle {r:?} is empty or not finite")));
             }
         }
         if let Some((r0, r1)) = self.patch_radii {
             if !(r0.is_finite() && r1.is_finite() && r0 >= 0.0 && r1 > r0) {
-                return Err(format!("mesh spec: patch radii must satisfy 0 <= r_min < r_max (got r_min {r0}, r_max {r1})"));
+                return Err(Error::invalid(format!("mesh spec: patch radii must satisfy 0 <= r_min < r_max (got r_min {r0}, r_max {r1})")));
             }
         }
         if self.contact_size < COARSE_CELL / f64::from(1u32 << MAX_LEVEL) {
-            return Err(format!("mesh spec: contact_size {} is below the minimum 16/2^{MAX_LEVEL}", self.contact_size));
+            return Err(Error::invalid(format!("mesh spec: contact_size {} is below the minimum 16/2^{MAX_LEVEL}", self.contact_size)));
         }
         Ok(())
     }
@@ -200,56 +204,56 @@ impl MeshSpec {
     /// has edges on the dyadic grid of spacing `h`, and lies in full-size
     /// (16 x 16 x 16) coarse cells so that the mesh over it is a uniform
     /// Kuhn grid of spacing `h`.
-    fn validate_rect(&self, h: f64) -> Result<(), String> {
+    fn validate_rect(&self, h: f64) -> Result<(), Error> {
         let r = self.contact;
         if !r.is_proper() {
-            return Err(format!("mesh spec: contact rectangle {r:?} is empty or not finite"));
+            return Err(Error::invalid(format!("mesh spec: contact rectangle {r:?} is empty or not finite")));
         }
         let (lo, hi) = self.bounds();
         let tol = 1e-12 * self.cube_edge;
         if r.x0 < lo[0] - tol || r.x1 > hi[0] + tol || r.z0 < lo[2] - tol || r.z1 > hi[2] + tol {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "mesh spec: contact rectangle {r:?} is not inside the top face \
                  x in [{}, {}], z in [{}, {}]",
                 lo[0], hi[0], lo[2], hi[2]
-            ));
+            )));
         }
         for v in [r.x0, r.x1, r.z0, r.z1] {
             if !on_dyadic_grid(v, h) {
-                return Err(format!(
+                return Err(Error::invalid(format!(
                     "mesh spec: contact rectangle edge {v} is not a multiple of the actual \
                      contact size {h} (requested {})",
                     self.contact_size
-                ));
+                )));
             }
         }
         self.validate_full_cells(h)
     }
 
     /// Checks that all coarse cells under the rectangle are full 16-cubes.
-    fn validate_full_cells(&self, _h: f64) -> Result<(), String> {
+    fn validate_full_cells(&self, _h: f64) -> Result<(), Error> {
         let r = self.contact;
         let g = self.coarse_grid();
         let top = g[1][g[1].len() - 2..].to_vec();
         if (top[1] - top[0] - COARSE_CELL).abs() > 1e-12 {
-            return Err(format!(
+            return Err(Error::invalid(format!(
                 "mesh spec: depth {} too small: the top coarse layer must be {COARSE_CELL} thick \
                  (need depth >= {})",
                 self.depth,
                 1.5 * COARSE_CELL
-            ));
+            )));
         }
         for (axis, (a, b)) in [(0usize, (r.x0, r.x1)), (2, (r.z0, r.z1))] {
             for w in g[axis].windows(2) {
                 let overlaps = w[1] > a && w[0] < b;
                 if overlaps && (w[1] - w[0] - COARSE_CELL).abs() > 1e-12 {
-                    return Err(format!(
+                    return Err(Error::invalid(format!(
                         "mesh spec: contact rectangle {r:?} overlaps the coarse cell [{}, {}] \
                          along axis {} which is not a full {COARSE_CELL}-cell; enlarge the box",
                         w[0],
                         w[1],
                         ["x", "y", "z"][axis]
-                    ));
+                    )));
                 }
             }
         }
@@ -333,7 +337,7 @@ mod tests {
     #[test]
     fn validation_accepts_paper_cases() {
         let mut s = MeshSpec::paper_default();
-        assert_eq!(s.validate(), Ok(0.25));
+        assert_eq!(s.validate().unwrap(), 0.25);
         s.contact = Rect { x0: -4.5, x1: 1.5, z0: -3.0, z1: 3.0 };
         assert!(s.validate().is_ok());
         s.half_z = true;
@@ -346,27 +350,27 @@ mod tests {
         let base = MeshSpec::paper_default();
         let mut s = base.clone();
         s.growth = 0.0;
-        assert!(s.validate().unwrap_err().contains("growth"));
+        assert!(s.validate().unwrap_err().to_string().contains("growth"));
         let mut s = base.clone();
         s.contact_size = -1.0;
-        assert!(s.validate().unwrap_err().contains("contact_size"));
+        assert!(s.validate().unwrap_err().to_string().contains("contact_size"));
         let mut s = base.clone();
         s.contact.x0 = -3.1;
-        assert!(s.validate().unwrap_err().contains("multiple"));
+        assert!(s.validate().unwrap_err().to_string().contains("multiple"));
         let mut s = base.clone();
         s.contact.x1 = 40.0;
-        assert!(s.validate().unwrap_err().contains("inside"));
+        assert!(s.validate().unwrap_err().to_string().contains("inside"));
         let mut s = base.clone();
         s.contact.x1 = 20.0;
-        assert!(s.validate().unwrap_err().contains("full"));
+        assert!(s.validate().unwrap_err().to_string().contains("full"));
         let mut s = base.clone();
         s.depth = 20.0;
-        assert!(s.validate().unwrap_err().contains("depth"));
+        assert!(s.validate().unwrap_err().to_string().contains("depth"));
         let mut s = base.clone();
         s.half_z = true; // R = [-3,3]^2 sticks out of z in [-30, 0]
-        assert!(s.validate().unwrap_err().contains("inside"));
+        assert!(s.validate().unwrap_err().to_string().contains("inside"));
         let mut s = base;
         s.contact.x0 = 3.0;
-        assert!(s.validate().unwrap_err().contains("empty"));
+        assert!(s.validate().unwrap_err().to_string().contains("empty"));
     }
 }

@@ -281,10 +281,10 @@ fn coarse_mesh_without_contact_refinement() {
 fn invalid_specs_are_rejected() {
     let mut s = MeshSpec::paper_default();
     s.contact.z1 = 3.1;
-    assert!(generate(&s).unwrap_err().contains("multiple"));
+    assert!(generate(&s).unwrap_err().to_string().contains("multiple"));
     s = MeshSpec::paper_default();
     s.cube_edge = f64::NAN;
-    assert!(generate(&s).unwrap_err().contains("cube_edge"));
+    assert!(generate(&s).unwrap_err().to_string().contains("cube_edge"));
 }
 
 /// Kuhn bisection produces finitely many shapes per coarse cell (3

@@ -5,6 +5,7 @@ pub mod plot;
 pub mod summary;
 pub mod vtu;
 
+use crate::error::{Error, IoAction};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -33,9 +34,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 
 /// As [`write_atomic`] for writers that take a path (plots, VTU): `write` fills the
 /// temporary file, which is then renamed to `path`, or removed on failure.
-pub fn write_atomic_with(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
+pub fn write_atomic_with(path: &Path, write: impl FnOnce(&Path) -> Result<(), Error>) -> Result<(), Error> {
     let tmp = temporary_path(path);
-    let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| format!("cannot write {}: {e}", path.display())));
+    let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(Error::writing(path)));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
@@ -69,14 +70,14 @@ fn host_name() -> String {
 /// doubles as the test that the folder is writable. A folder whose lock names a live
 /// process (on this host) or another host is in use: refused. A lock left by a process
 /// that no longer exists (killed) is taken over.
-pub fn claim_output_dir(dir: &Path) -> Result<OutputClaim, String> {
+pub fn claim_output_dir(dir: &Path) -> Result<OutputClaim, Error> {
     let mut created = None;
     let mut a = Some(dir);
     while let Some(p) = a.filter(|p| !p.as_os_str().is_empty() && !p.exists()) {
         created = Some(p.to_path_buf());
         a = p.parent();
     }
-    std::fs::create_dir_all(dir).map_err(|e| format!("output folder '{}' cannot be created: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(Error::io(IoAction::CreateOutputFolder, dir))?;
     let claim = OutputClaim { dir: dir.to_path_buf(), created, lock: dir.join(LOCK_FILE) };
     let me = format!("{} {}\n", std::process::id(), host_name());
     for attempt in 0..2 {
@@ -85,7 +86,7 @@ pub fn claim_output_dir(dir: &Path) -> Result<OutputClaim, String> {
                 if let Err(e) = f.write_all(me.as_bytes()).and_then(|()| f.sync_all()) {
                     drop(f);
                     claim.release(false);
-                    return Err(format!("output folder '{}' is not writable: {e}", dir.display()));
+                    return Err(Error::io(IoAction::OutputFolderNotWritable, dir)(e));
                 }
                 return Ok(claim);
             }
@@ -100,12 +101,12 @@ pub fn claim_output_dir(dir: &Path) -> Result<OutputClaim, String> {
                     None => false,
                 };
                 if alive {
-                    return Err(format!(
+                    return Err(Error::invalid(format!(
                         "output folder '{}' is in use by another run (process {} on host {host}; lock file {}); choose another folder with --output, or remove the lock file if no run uses the folder",
                         dir.display(),
                         pid.map_or("?".into(), |p| p.to_string()),
                         claim.lock.display()
-                    ));
+                    )));
                 }
                 // A stale lock (its process has ended, e.g. SIGKILLed by mpirun's
                 // teardown): take it over, with what that process left half-done.
@@ -116,11 +117,11 @@ pub fn claim_output_dir(dir: &Path) -> Result<OutputClaim, String> {
             }
             Err(e) => {
                 claim.release(false);
-                return Err(format!("output folder '{}' is not writable: {e}", dir.display()));
+                return Err(Error::io(IoAction::OutputFolderNotWritable, dir)(e));
             }
         }
     }
-    Err(format!("output folder '{}': cannot take its lock file {}", dir.display(), claim.lock.display()))
+    Err(Error::invalid(format!("output folder '{}': cannot take its lock file {}", dir.display(), claim.lock.display())))
 }
 
 /// Removes what a killed run with process id `pid` left in `dir`: its staging folder
@@ -165,8 +166,8 @@ impl OutputClaim {
 /// Moves every file of `staging` into `dir` (an old summary.json removed first, the new
 /// one moved last, so that a summary always describes the files next to it) and removes
 /// `staging`.
-pub fn publish(staging: &Path, dir: &Path) -> Result<(), String> {
-    let err = |e: std::io::Error| format!("cannot move the results from {} to {}: {e}", staging.display(), dir.display());
+pub fn publish(staging: &Path, dir: &Path) -> Result<(), Error> {
+    let err = |e| Error::io(IoAction::MoveResults { to: dir.to_path_buf() }, staging)(e);
     let mut names: Vec<std::ffi::OsString> =
         std::fs::read_dir(staging).map_err(err)?.filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
     names.sort_by_key(|n| n == "summary.json");

@@ -5,6 +5,7 @@
 //!
 //! JSON has no NaN: a non-finite number is written as null and read back as NaN.
 use crate::case::Scene;
+use crate::error::{Error, ResultExt};
 use serde::{Deserialize, Deserializer, Serialize};
 
 /// Reads null (a NaN or infinity when written) as NaN.
@@ -229,20 +230,20 @@ pub struct ElasticSummary {
 }
 
 /// A summary as JSON (keys sorted; non-finite numbers null).
-pub fn to_json<T: Serialize>(summary: &T) -> Result<serde_json::Value, String> {
-    serde_json::to_value(summary).map_err(|e| format!("cannot encode summary.json: {e}"))
+pub fn to_json<T: Serialize>(summary: &T) -> Result<serde_json::Value, Error> {
+    serde_json::to_value(summary).map_err(|e| Error::other(format!("cannot encode summary.json: {e}")))
 }
 
 impl Summary {
     /// Reads a lubricated run's summary from JSON text.
-    pub fn from_json(text: &str) -> Result<Summary, String> {
-        serde_json::from_str(text).map_err(|e| e.to_string())
+    pub fn from_json(text: &str) -> Result<Summary, Error> {
+        serde_json::from_str(text).map_err(|e| Error::format(e.to_string()))
     }
 
     /// Reads `dir/summary.json`.
-    pub fn read(dir: &std::path::Path) -> Result<Summary, String> {
+    pub fn read(dir: &std::path::Path) -> Result<Summary, Error> {
         let path = dir.join("summary.json");
-        let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-        Summary::from_json(&text).map_err(|e| format!("{}: {e}", path.display()))
+        let text = std::fs::read_to_string(&path).map_err(Error::reading(&path))?;
+        Summary::from_json(&text).context(path.display().to_string())
     }
 }

@@ -4,26 +4,7 @@ use std::cell::RefCell;
 use std::ffi::CStr;
 use std::os::raw::{c_char, c_int, c_void};
 
-/// An error reported by PETSc (non-zero `PetscErrorCode`) or by this safe layer.
-#[derive(Debug, Clone)]
-pub struct PetscError {
-    /// PETSc's error code (0 for errors raised by the Rust layer itself).
-    pub code: i32,
-    /// PETSc's messages, innermost first ("function (file:line): message").
-    pub message: String,
-}
-
-impl std::fmt::Display for PetscError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        if self.code == 0 {
-            // Raised by the Rust layer (e.g. an interruption): its own message says it all.
-            write!(f, "{}", self.message)
-        } else {
-            write!(f, "PETSc error {}: {}", self.code, self.message)
-        }
-    }
-}
-impl std::error::Error for PetscError {}
+pub use crate::error::PetscError;
 
 pub type Result<T> = std::result::Result<T, PetscError>;
 

@@ -10,6 +10,7 @@
 //! and the properties stay within a few per cent of their ambient values however negative
 //! p gets (a plain tangent let eta fall like exp(alpha p): an overshoot to -4 GPa gave
 //! eta/eta_R ~ 1e-42 and wrecked Newton).
+use crate::error::Error;
 
 /// Pressure scale P_N (Pa) over which the laws saturate for p < 0 (see the module doc).
 pub const NEGATIVE_PRESSURE_SCALE: f64 = 1e7;
@@ -80,20 +81,20 @@ impl ViscosityLaw {
     /// coefficient at p = 0 equals alpha (see [`Self::roelands_exponent`]).
     ///
     /// Errors if ln eta_R + 9.67 <= 0 (eta_R <= 6.31e-5 Pa.s) or an argument is not finite.
-    pub fn roelands(eta_r: f64, alpha: f64, p_r: f64, z_r: Option<f64>) -> Result<Self, String> {
+    pub fn roelands(eta_r: f64, alpha: f64, p_r: f64, z_r: Option<f64>) -> Result<Self, Error> {
         let s = eta_r.ln() - ROELANDS_LN_ETA_INFINITY;
         if !(eta_r.is_finite() && p_r.is_finite() && p_r > 0.0) {
-            return Err(format!("Roelands law needs finite eta_R > 0 and P_R > 0 (got eta_R = {eta_r}, P_R = {p_r})"));
+            return Err(Error::invalid(format!("Roelands law needs finite eta_R > 0 and P_R > 0 (got eta_R = {eta_r}, P_R = {p_r})")));
         }
         if s.is_nan() || s <= 0.0 {
-            return Err(format!("Roelands law needs eta_R > exp(-9.67) = 6.31e-5 Pa.s (got eta_R = {eta_r} Pa.s)"));
+            return Err(Error::invalid(format!("Roelands law needs eta_R > exp(-9.67) = 6.31e-5 Pa.s (got eta_R = {eta_r} Pa.s)")));
         }
         let z_r = match z_r {
             Some(z) => z,
             None => Self::roelands_exponent(eta_r, alpha, p_r),
         };
         if !z_r.is_finite() {
-            return Err(format!("Roelands exponent z_R = {z_r} is not finite"));
+            return Err(Error::invalid(format!("Roelands exponent z_R = {z_r} is not finite")));
         }
         Ok(ViscosityLaw::Roelands { eta_r, p_r, z_r })
     }

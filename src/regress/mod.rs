@@ -4,6 +4,7 @@
 //! `ci/regress` and `ci/hard` call.
 pub mod hard;
 
+use crate::error::Error;
 use serde_json::Value;
 use std::collections::BTreeMap;
 
@@ -105,8 +106,8 @@ impl Tolerances {
     /// "timing.*" = "ignore"
     /// "fz" = { rel = 1e-6, abs = 1e-12 }
     /// ```
-    pub fn parse(text: &str) -> Result<Self, String> {
-        let t: toml::Table = toml::from_str(text).map_err(|e| format!("tolerance file: {e}"))?;
+    pub fn parse(text: &str) -> Result<Self, Error> {
+        let t: toml::Table = toml::from_str(text).map_err(|e| Error::invalid(format!("tolerance file: {e}")))?;
         let default = match t.get("default") {
             None => Tolerance::Within { rel: 1e-6, abs: 0.0 },
             Some(v) => parse_tolerance("default", v)?,
@@ -116,12 +117,12 @@ impl Tolerances {
             match k.as_str() {
                 "default" => {}
                 "keys" => {
-                    let keys = v.as_table().ok_or("tolerance file: [keys] must be a table")?;
+                    let keys = v.as_table().ok_or_else(|| Error::invalid("tolerance file: [keys] must be a table"))?;
                     for (pat, tv) in keys {
                         rules.push((pat.clone(), parse_tolerance(pat, tv)?));
                     }
                 }
-                other => return Err(format!("tolerance file: unknown key '{other}' (allowed: default, [keys])")),
+                other => return Err(Error::invalid(format!("tolerance file: unknown key '{other}' (allowed: default, [keys])"))),
             }
         }
         Ok(Tolerances { default, rules })
@@ -146,9 +147,12 @@ impl Tolerances {
     }
 }
 
-fn parse_tolerance(key: &str, v: &toml::Value) -> Result<Tolerance, String> {
-    let bad =
-        || format!("tolerance file: '{key}' = {v}: expected a relative tolerance (number >= 0), \"ignore\" or {{ rel = .., abs = .. }}");
+fn parse_tolerance(key: &str, v: &toml::Value) -> Result<Tolerance, Error> {
+    let bad = || {
+        Error::invalid(format!(
+            "tolerance file: '{key}' = {v}: expected a relative tolerance (number >= 0), \"ignore\" or {{ rel = .., abs = .. }}"
+        ))
+    };
     let num = |x: &toml::Value| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)).filter(|f| *f >= 0.0);
     match v {
         toml::Value::String(s) if s == "ignore" => Ok(Tolerance::Ignore),
@@ -376,9 +380,9 @@ default = 1e-6
 
     #[test]
     fn bad_tolerance_file_names_the_key() {
-        let e = Tolerances::parse("[keys]\n\"film.*\" = -1\n").unwrap_err();
+        let e = Tolerances::parse("[keys]\n\"film.*\" = -1\n").unwrap_err().to_string();
         assert!(e.contains("film.*"), "{e}");
-        assert!(Tolerances::parse("defualt = 1e-6\n").unwrap_err().contains("defualt"));
+        assert!(Tolerances::parse("defualt = 1e-6\n").unwrap_err().to_string().contains("defualt"));
     }
 
     #[test]

@@ -11,6 +11,7 @@ use super::problem::{lambda_bar, lubricant, penalty, velocity_field};
 use crate::case::Scene;
 use crate::context::Context;
 use crate::ehl::system::EhlProblem;
+use crate::error::Error;
 use crate::petsc::snes::{Snes, SolveReport};
 use crate::petsc::{self, Matrix, Vector};
 
@@ -181,17 +182,16 @@ impl Newton<'_> {
     }
 
     /// One Newton solve of the scene `sc` from `start`.
-    fn solve(&mut self, sc: &Scene, system: &mut dyn EhlProblem, start: &[f64]) -> Result<SolveReport, String> {
-        let pe = |e: petsc::PetscError| e.to_string();
+    fn solve(&mut self, sc: &Scene, system: &mut dyn EhlProblem, start: &[f64]) -> Result<SolveReport, Error> {
         let (lo, hi) = self.owned;
         system.set_operating(lambda_bar(sc), lubricant(sc), penalty(sc));
-        self.x.set_local_values(&start[lo..hi]).map_err(pe)?;
+        self.x.set_local_values(&start[lo..hi])?;
         if self.row_scaling {
-            system.scale_rows(start).map_err(pe)?;
+            system.scale_rows(start)?;
         }
         system.take_collapse();
         self.collapse = None;
-        let mut r = self.snes.solve(system, &self.x, self.j).map_err(pe)?;
+        let mut r = self.snes.solve(system, &self.x, self.j)?;
         if r.reason_code == petsc::ffi::SNESConvergedReason_SNES_DIVERGED_LINEAR_SOLVE {
             // A failed factorisation leaves the solver failing every later solve at its
             // first step (M = 100, L = 20 at 0.0625 a: nine continuation steps in a row
@@ -199,20 +199,20 @@ impl Newton<'_> {
             // and the same solve once more. When MUMPS's analysis underestimated a
             // workspace (delayed pivots of the exp(alpha p) rows), a fresh LU with the
             // same estimate fails again: the new one gets a larger ICNTL(14).
-            let why = self.snes.linear_failure().map_err(pe)?;
-            let more = more_mumps_workspace(&why).map_err(pe)?;
+            let why = self.snes.linear_failure()?;
+            let more = more_mumps_workspace(&why)?;
             self.note(format!("Newton: {} after {} iterations ({why}); again with a new linear solver{more}", r.reason, r.iterations));
             self.iterations += r.iterations;
-            self.snes = Snes::new(petsc::comm_world(), "").map_err(pe)?;
-            self.x.set_local_values(&start[lo..hi]).map_err(pe)?;
+            self.snes = Snes::new(petsc::comm_world(), "")?;
+            self.x.set_local_values(&start[lo..hi])?;
             system.take_collapse();
-            r = self.snes.solve(system, &self.x, self.j).map_err(pe)?;
+            r = self.snes.solve(system, &self.x, self.j)?;
             if r.reason_code == petsc::ffi::SNESConvergedReason_SNES_DIVERGED_LINEAR_SOLVE {
                 // Out of the machine's memory or of the user's MUMPS memory limit: no milder
                 // problem has a smaller factorisation, so the continuation would only repeat it.
-                let why = self.snes.linear_failure().map_err(pe)?;
+                let why = self.snes.linear_failure()?;
                 if why.mumps_infog.is_some_and(|(i, _)| petsc::factor::mumps_memory_code(i)) {
-                    return Err(format!("the linear solver cannot factorise the Jacobian: {why}"));
+                    return Err(Error::NotConverged(format!("the linear solver cannot factorise the Jacobian: {why}")));
                 }
             }
         }
@@ -224,8 +224,8 @@ impl Newton<'_> {
     }
 
     /// The converged iterate of the last solve, gathered.
-    fn solution(&self) -> Result<Vec<f64>, String> {
-        self.x.gather_all().map_err(|e| e.to_string())
+    fn solution(&self) -> Result<Vec<f64>, Error> {
+        Ok(self.x.gather_all()?)
     }
 
     /// One Newton solve of `from` with `p` at t, from `start`; the step is logged (`what`
@@ -239,7 +239,7 @@ impl Newton<'_> {
         system: &mut dyn EhlProblem,
         start: &[f64],
         what: &str,
-    ) -> Result<(SolveReport, Option<Vec<f64>>), String> {
+    ) -> Result<(SolveReport, Option<Vec<f64>>), Error> {
         crate::interrupt::check("the continuation")?;
         let mut sc = from.clone();
         p.apply(&mut sc, t);
@@ -256,10 +256,9 @@ impl Newton<'_> {
                 r.reason,
                 r.iterations
             ));
-            let pe = |e: petsc::PetscError| e.to_string();
-            petsc::options::set_ours("-snes_linesearch_type", "bt").map_err(pe)?;
+            petsc::options::set_ours("-snes_linesearch_type", "bt")?;
             let again = self.solve(&sc, system, start);
-            petsc::options::set_ours("-snes_linesearch_type", "l2").map_err(pe)?;
+            petsc::options::set_ours("-snes_linesearch_type", "l2")?;
             r = again?;
         }
         self.iterations += r.iterations;
@@ -278,7 +277,7 @@ impl Newton<'_> {
         system: &mut dyn EhlProblem,
         x0: &[f64],
         label: &str,
-    ) -> Result<Option<(f64, Vec<f64>)>, String> {
+    ) -> Result<Option<(f64, Vec<f64>)>, Error> {
         let (p, lowest) = (h.parameter, h.ramp.lowest);
         let mut t = h.ramp.first;
         while t >= lowest {
@@ -315,7 +314,7 @@ impl Newton<'_> {
         mut t: f64,
         mut state: Vec<f64>,
         system: &mut dyn EhlProblem,
-    ) -> Result<(bool, Option<SolveReport>, Vec<f64>), String> {
+    ) -> Result<(bool, Option<SolveReport>, Vec<f64>), Error> {
         let mut ratio = h.ramp.ratio;
         let mut last = None;
         while t < 1.0 {
@@ -357,16 +356,15 @@ pub(super) fn newton_with_continuation(
     j: &Matrix,
     owned: (usize, usize),
     local: usize,
-) -> Result<NewtonOutcome, String> {
-    let pe = |e: petsc::PetscError| e.to_string();
-    petsc::options::set_ours("-snes_linesearch_type", policy.line_search).map_err(pe)?;
-    set_newton_linear_solver(policy.reuses_lu).map_err(pe)?;
+) -> Result<NewtonOutcome, Error> {
+    petsc::options::set_ours("-snes_linesearch_type", policy.line_search)?;
+    set_newton_linear_solver(policy.reuses_lu)?;
     let comm = petsc::comm_world();
     let opts = crate::ehl_options::get();
     let mut nw = Newton {
         ctx,
-        snes: Snes::new(comm, "").map_err(pe)?,
-        x: Vector::new(comm, local).map_err(pe)?,
+        snes: Snes::new(comm, "")?,
+        x: Vector::new(comm, local)?,
         j,
         owned,
         row_scaling: opts.row_scaling,
@@ -458,11 +456,11 @@ pub(super) fn newton_with_continuation(
             ),
             None => "no continuation step reached a solve".into(),
         };
-        return Err(format!(
+        return Err(Error::NotConverged(format!(
             "Newton did not converge: {end}{}; path: {}",
             nw.collapse.and_then(|c| c.at_pole()).map(|w| format!("; {w}")).unwrap_or_default(),
             nw.steps.join("; ")
-        ));
+        )));
     };
     let last = last.clone();
     Ok(NewtonOutcome { x: xs, report: last, newton_total: nw.iterations, steps: nw.steps, continued })

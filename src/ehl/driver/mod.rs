@@ -15,6 +15,7 @@ mod policy;
 mod problem;
 mod start;
 
+use crate::error::Error;
 pub use diagnostics::check_jacobian;
 use policy::Attempt;
 pub use policy::{set_newton_defaults, set_newton_linear_solver, Coupling, CONDENSED_PREFIX};
@@ -83,8 +84,8 @@ impl<'a> EhlSolver<'a> {
         dofs: &'a DofMap,
         layout: &'a Layout,
         half: bool,
-    ) -> Result<Self, String> {
-        set_newton_defaults().map_err(|e| e.to_string())?;
+    ) -> Result<Self, Error> {
+        set_newton_defaults()?;
         let p_nodes = pressure_nodes(mesh, layout);
         let coupling = Coupling::of_scene(scene, p_nodes.len());
         let (rigid, monolithic) = (coupling == Coupling::Rigid, coupling == Coupling::Monolithic);
@@ -92,13 +93,13 @@ impl<'a> EhlSolver<'a> {
             ctx.log(format!("coupling: monolithic (reynolds.coupling = \"{}\", {} pressure unknowns): U, P and H0 in one sparse matrix, a MUMPS LU at every Newton step (every third step, GMRES in between, from a start near the solution)", scene.reynolds.coupling, p_nodes.len()));
             // The condensed path picks its solver by the Jacobian's type (see `solve_condensed`);
             // a convergence study may have run it before in this process.
-            petsc::ksp::set_direct_solver_defaults("").map_err(|e| e.to_string())?;
-            petsc::options::set_ours("-mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
+            petsc::ksp::set_direct_solver_defaults("")?;
+            petsc::options::set_ours("-mat_mumps_icntl_7", "4")?;
         } else {
             // The condensed Jacobian is dense: MUMPS's PORD ordering rejects it, AMD is fine.
-            petsc::options::set_ours("-mat_mumps_icntl_7", "0").map_err(|e| e.to_string())?;
+            petsc::options::set_ours("-mat_mumps_icntl_7", "0")?;
             // The condensation's 3D Cholesky has its own prefix and keeps PORD.
-            petsc::options::set_default("-elastic_mat_mumps_icntl_7", "4").map_err(|e| e.to_string())?;
+            petsc::options::set_default("-elastic_mat_mumps_icntl_7", "4")?;
         }
         let t0 = std::time::Instant::now();
         let comp = if rigid {
@@ -112,8 +113,7 @@ impl<'a> EhlSolver<'a> {
         } else {
             ctx.log(format!("coupling: condensed (reynolds.coupling = \"{}\", {} pressure unknowns): the elastic block eliminated onto the contact face, a dense LU at every Newton step", scene.reynolds.coupling, p_nodes.len()));
             let eq = scene.equivalent_solid();
-            let comp = crate::solid::condense::face_compliance(&ctx.world, mesh, eq.nu, assembly::traction_factor(eq.nu), &p_nodes)
-                .map_err(|e| e.to_string())?;
+            let comp = crate::solid::condense::face_compliance(&ctx.world, mesh, eq.nu, assembly::traction_factor(eq.nu), &p_nodes)?;
             ctx.log(format!(
                 "elastic block condensed onto the contact face: {} elastic unknowns -> {} face nodes x {} pressure nodes ({:.2} s)",
                 comp.elastic_unknowns,
@@ -136,7 +136,7 @@ impl<'a> EhlSolver<'a> {
     /// Solves the scene's operating point. `start`: a converged state of a neighbouring
     /// operating point (monolithic layout, as in [`EhlSolution::x`]); when Newton fails
     /// from it, the solve starts over from the Hertz start. Collective.
-    pub fn solve(&self, ctx: &Context, scene: &Scene, start: Option<&[f64]>) -> Result<EhlSolution, String> {
+    pub fn solve(&self, ctx: &Context, scene: &Scene, start: Option<&[f64]>) -> Result<EhlSolution, Error> {
         self.solve_from(ctx, scene, start.map_or(Start::Hertz, Start::Previous))
     }
 
@@ -144,7 +144,7 @@ impl<'a> EhlSolver<'a> {
     /// [`Attempt::ladder`] in order (plain Newton, the monolithic LU reused; from another
     /// mesh's pressure then the continuation from that pressure), then the Hertz start with
     /// its automatic continuation. Collective.
-    pub fn solve_from(&self, ctx: &Context, scene: &Scene, start: Start) -> Result<EhlSolution, String> {
+    pub fn solve_from(&self, ctx: &Context, scene: &Scene, start: Start) -> Result<EhlSolution, Error> {
         let once = |start: Start, attempt: Attempt| match &self.comp {
             None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, attempt),
             Some(comp) => solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, start, attempt),
@@ -176,7 +176,7 @@ pub fn solve(
     dofs: &DofMap,
     layout: &Layout,
     half: bool,
-) -> Result<EhlSolution, String> {
+) -> Result<EhlSolution, Error> {
     EhlSolver::new(ctx, scene, mesh, part, dofs, layout, half)?.solve(ctx, scene, None)
 }
 
@@ -198,8 +198,7 @@ fn solve_condensed(
     half: bool,
     start: Start,
     attempt: Attempt,
-) -> Result<EhlSolution, String> {
-    let pe = |e: petsc::PetscError| e.to_string();
+) -> Result<EhlSolution, Error> {
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
@@ -234,14 +233,14 @@ fn solve_condensed(
     };
     let (d_nnz, o_nnz) = system.preallocation();
     let j = if comp.is_rigid() {
-        Matrix::new_aij(comm, cl.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?
+        Matrix::new_aij(comm, cl.local(ctx.rank), &d_nnz, &o_nnz)?
     } else {
-        let j = Matrix::new_dense(comm, cl.local(ctx.rank), CONDENSED_PREFIX, &d_nnz, &o_nnz).map_err(pe)?;
-        let (rows, cols) = j.dense_fill_block(cl.total()).map_err(pe)?;
+        let j = Matrix::new_dense(comm, cl.local(ctx.rank), CONDENSED_PREFIX, &d_nnz, &o_nnz)?;
+        let (rows, cols) = j.dense_fill_block(cl.total())?;
         system.set_fill_block(rows, cols);
         j
     };
-    petsc::ksp::set_direct_solver_defaults_for("", &j).map_err(pe)?;
+    petsc::ksp::set_direct_solver_defaults_for("", &j)?;
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
     let (lo, hi) = (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]);
@@ -302,17 +301,16 @@ fn solve_monolithic(
     half: bool,
     start: Start,
     attempt: Attempt,
-) -> Result<EhlSolution, String> {
-    let pe = |e: petsc::PetscError| e.to_string();
+) -> Result<EhlSolution, Error> {
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
-    let k = assembly::assemble_stiffness(comm, mesh, part, dofs, ctx.rank, eq.nu).map_err(pe)?;
+    let k = assembly::assemble_stiffness(comm, mesh, part, dofs, ctx.rank, eq.nu)?;
     let x0 = match start {
         Start::Previous(prev) => prev.to_vec(),
         Start::Hertz | Start::Pressure { .. } => {
             let (p, hc) = start.pressure(scene);
-            let u_dry = elastic_start(comm, ctx, mesh, part, dofs, &k, eq.nu, p).map_err(pe)?;
+            let u_dry = elastic_start(comm, ctx, mesh, part, dofs, &k, eq.nu, p)?;
             // Initial iterate: the start pressure, its displacement, H0 from the central film.
             let mut x0 = vec![0.0; layout.total()];
             for n in 0..mesh.nodes.len() {
@@ -334,9 +332,8 @@ fn solve_monolithic(
     };
     let label = start.label();
     let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank);
-    let j = Matrix::new_aij(comm, layout.local(ctx.rank), &d_nnz, &o_nnz).map_err(pe)?;
-    let mut system =
-        EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene), k).map_err(pe)?;
+    let j = Matrix::new_aij(comm, layout.local(ctx.rank), &d_nnz, &o_nnz)?;
+    let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene), k)?;
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
     ctx.log(format!(
@@ -347,9 +344,9 @@ fn solve_monolithic(
     ));
     if crate::ehl_options::get().check_jacobian {
         if crate::ehl_options::get().row_scaling {
-            system.scale_rows(&x0).map_err(pe)?;
+            system.scale_rows(&x0)?;
         }
-        for (r, c, e) in check_jacobian(&mut system, layout, ctx.rank, &x0, &j).map_err(pe)? {
+        for (r, c, e) in check_jacobian(&mut system, layout, ctx.rank, &x0, &j)? {
             ctx.log(format!("Jacobian check: rows {r:2} cols {c:2}: max |J v - FD| / max |J v| = {e:.3e}"));
         }
     }

@@ -7,6 +7,7 @@ use crate::context::Context;
 use crate::ehl::condensed::CondensedSystem;
 use crate::ehl::layout::Layout;
 use crate::ehl::system::EhlProblem;
+use crate::error::Error;
 use crate::mesh::{Mesh, Partition};
 use crate::petsc::snes::Snes;
 use crate::petsc::{self, Ksp, Matrix, Vector};
@@ -86,8 +87,8 @@ const START_PREFIX: &str = "start_";
 /// starting deflection at the centre, raised if needed so that the starting film is
 /// positive everywhere (a coarse mesh's dry deflection is not flat in the contact). `uy`
 /// gives U_y at a contact node.
-pub(super) fn start_h0(hc: f64, mesh: &Mesh, uy: &dyn Fn(u32) -> f64) -> Result<f64, String> {
-    let centre = mesh.locate_contact(0.0, 0.0).ok_or("contact centre not on the contact face")?;
+pub(super) fn start_h0(hc: f64, mesh: &Mesh, uy: &dyn Fn(u32) -> f64) -> Result<f64, Error> {
+    let centre = mesh.locate_contact(0.0, 0.0).ok_or_else(|| Error::other("contact centre not on the contact face"))?;
     let uy_centre = crate::fem::p2_tri_eval(&mesh.contact_tris[centre.0].map(uy), centre.1);
     let min_gap = mesh.contact_nodes.iter().map(|&n| Layout::gap(mesh.nodes[n as usize]) - uy(n)).fold(f64::INFINITY, f64::min);
     Ok((hc + uy_centre).max(0.5 * hc - min_gap))
@@ -105,16 +106,15 @@ pub(super) fn rigid_start(
     x0: &mut [f64],
     (lo, hi): (usize, usize),
     local: usize,
-) -> Result<(), String> {
-    let pe = |e: petsc::PetscError| e.to_string();
+) -> Result<(), Error> {
     let comm = petsc::comm_world();
     let n = x0.len();
     let np = n - 1;
     x0[..np].iter_mut().for_each(|p| *p = 0.0);
     let mut h0 = x0[np];
     let (d, o) = system.preallocation();
-    let j = Matrix::new_aij(comm, local, &d, &o).map_err(pe)?;
-    let x = Vector::new(comm, local).map_err(pe)?;
+    let j = Matrix::new_aij(comm, local, &d, &o)?;
+    let x = Vector::new(comm, local)?;
     // Its own options prefix: the frozen-film solves cross the cavitation penalty's kink
     // node by node and may need more iterations than the main Newton's default.
     for (k, v) in [
@@ -123,19 +123,19 @@ pub(super) fn rigid_start(
         ("-rigid_start_snes_stol", "0"),
         ("-rigid_start_snes_linesearch_type", "bt"),
     ] {
-        petsc::options::set_default(k, v).map_err(pe)?;
+        petsc::options::set_default(k, v)?;
     }
-    petsc::ksp::set_direct_solver_defaults("rigid_start_").map_err(pe)?;
-    let snes = Snes::new(comm, "rigid_start_").map_err(pe)?;
+    petsc::ksp::set_direct_solver_defaults("rigid_start_")?;
+    let snes = Snes::new(comm, "rigid_start_")?;
     let target = system.params.load;
     let mut prev: Option<(f64, f64)> = None;
     let mut result = Ok(());
     for it in 0..12 {
         system.fixed_h0 = Some(h0);
         x0[np] = h0;
-        system.scale_rows(x0).map_err(pe)?;
-        x.set_local_values(&x0[lo..hi]).map_err(pe)?;
-        let r = snes.solve(system, &x, &j).map_err(pe)?;
+        system.scale_rows(x0)?;
+        x.set_local_values(&x0[lo..hi])?;
+        let r = snes.solve(system, &x, &j)?;
         if !r.converged {
             if prev.is_none() && it < 4 {
                 // A too thin first guess: the frozen film is much thinner than the
@@ -145,10 +145,11 @@ pub(super) fn rigid_start(
                 x0[..np].iter_mut().for_each(|p| *p = 0.0);
                 continue;
             }
-            result = Err(format!("rigid start: the pressure of the film H0 = {h0:.4e} did not converge ({})", r.reason));
+            result =
+                Err(Error::NotConverged(format!("rigid start: the pressure of the film H0 = {h0:.4e} did not converge ({})", r.reason)));
             break;
         }
-        let xs = x.gather_all().map_err(pe)?;
+        let xs = x.gather_all()?;
         x0[..np].copy_from_slice(&xs[..np]);
         let w = system.load(x0);
         ctx.log(format!("rigid start {}: H0 = {h0:.5e}, load {:.4} of the target ({} iterations)", it + 1, w / target, r.iterations));

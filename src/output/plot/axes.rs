@@ -1,5 +1,6 @@
 //! Axes and ticks: linear and log scales, tick placement and labels, frame, grid.
 use super::*;
+use crate::error::Error;
 
 #[derive(Clone, Debug)]
 pub(super) struct Axis {
@@ -164,9 +165,9 @@ pub(super) fn data_range(vals: impl Iterator<Item = f64>, log: bool, pad: f64) -
     }
 }
 
-pub(super) fn check_range(r: (f64, f64), log: bool, what: &str) -> Result<(f64, f64), String> {
+pub(super) fn check_range(r: (f64, f64), log: bool, what: &str) -> Result<(f64, f64), Error> {
     if !r.0.is_finite() || !r.1.is_finite() || r.0 >= r.1 || (log && r.0 <= 0.0) {
-        return Err(format!("invalid {what} range {:?}", r));
+        return Err(Error::invalid(format!("invalid {what} range {:?}", r)));
     }
     Ok(r)
 }
@@ -254,9 +255,9 @@ pub(super) fn draw_circle(cv: &mut Canvas, x: &Axis, y: &Axis, c: (f64, f64, f64
     cv.dashed_ellipse(x.px(c.0), y.px(c.1), c.2 * x.scale().abs(), c.2 * y.scale().abs(), bx);
 }
 
-pub(super) fn check_finite(vals: impl IntoIterator<Item = f64>, what: &str) -> Result<(), String> {
+pub(super) fn check_finite(vals: impl IntoIterator<Item = f64>, what: &str) -> Result<(), Error> {
     match vals.into_iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        Some((i, v)) => Err(format!("{what}: value {i} is {v} (all plot data must be finite)")),
+        Some((i, v)) => Err(Error::invalid(format!("{what}: value {i} is {v} (all plot data must be finite)"))),
         None => Ok(()),
     }
 }

@@ -1,6 +1,7 @@
 //! Canvas, text, colours: the rasteriser (lines, discs, triangles, Gouraud shading), text
 //! with ab_glyph, the colour maps.
 use super::*;
+use crate::error::{Error, IoAction};
 
 pub(super) type Rgb = (u8, u8, u8);
 pub(super) const PALETTE: [Rgb; 10] = [
@@ -47,9 +48,9 @@ pub(super) struct TextCmd {
     pub(super) rot: bool,
 }
 
-pub(super) fn check_size(w: u32, h: u32) -> Result<(), String> {
+pub(super) fn check_size(w: u32, h: u32) -> Result<(), Error> {
     if !(200..=10000).contains(&w) || !(150..=10000).contains(&h) {
-        return Err(format!("plot size {w}x{h} out of range (200..10000 x 150..10000)"));
+        return Err(Error::invalid(format!("plot size {w}x{h} out of range (200..10000 x 150..10000)")));
     }
     Ok(())
 }
@@ -66,7 +67,7 @@ pub(super) struct Canvas {
 }
 
 impl Canvas {
-    pub(super) fn new(w: u32, h: u32) -> Result<Canvas, String> {
+    pub(super) fn new(w: u32, h: u32) -> Result<Canvas, Error> {
         check_size(w, h)?;
         Ok(Canvas { w, h, buf: vec![255; (w * h * 3) as usize], texts: Vec::new() })
     }
@@ -270,7 +271,7 @@ impl Canvas {
         }
     }
     /// Draws the queued text, encodes the PNG and writes it atomically.
-    pub(super) fn save(mut self, path: &Path) -> Result<(), String> {
+    pub(super) fn save(mut self, path: &Path) -> Result<(), Error> {
         let font = font()?;
         for t in std::mem::take(&mut self.texts) {
             self.render_text(font, &t);
@@ -280,10 +281,10 @@ impl Canvas {
             let mut enc = png::Encoder::new(&mut png_bytes, self.w, self.h);
             enc.set_color(png::ColorType::Rgb);
             enc.set_depth(png::BitDepth::Eight);
-            let mut wr = enc.write_header().map_err(|e| format!("png: {e}"))?;
-            wr.write_image_data(&self.buf).map_err(|e| format!("png: {e}"))?;
+            let mut wr = enc.write_header().map_err(|e| Error::other(format!("png: {e}")))?;
+            wr.write_image_data(&self.buf).map_err(|e| Error::other(format!("png: {e}")))?;
         }
-        crate::output::write_atomic(path, &png_bytes).map_err(|e| format!("cannot write plot '{}': {e}", path.display()))
+        crate::output::write_atomic(path, &png_bytes).map_err(Error::io(IoAction::WritePlot, path))
     }
     /// Queues `s` anchored at (x, y); `rot` turns it 90 degrees counter-clockwise (reads bottom to top).
     #[allow(clippy::too_many_arguments)]

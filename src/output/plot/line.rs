@@ -1,25 +1,26 @@
 //! Line plots: series on linear or log axes, secondary y axis, legend.
 use super::*;
+use crate::error::Error;
 
 /// Line/point plot of one or more series, optionally with log axes and a secondary y axis.
-pub fn line_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &[Series], opts: &LineOpts) -> Result<(), String> {
+pub fn line_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &[Series], opts: &LineOpts) -> Result<(), Error> {
     ensure_font()?;
     check_size(opts.width, opts.height)?;
     if series.is_empty() || series.iter().all(|s| s.x.is_empty()) {
-        return Err("line_plot: no data".to_string());
+        return Err(Error::invalid("line_plot: no data"));
     }
     for s in series {
         if s.x.len() != s.y.len() {
-            return Err(format!("line_plot: series '{}' has {} x and {} y values", s.label, s.x.len(), s.y.len()));
+            return Err(Error::invalid(format!("line_plot: series '{}' has {} x and {} y values", s.label, s.x.len(), s.y.len())));
         }
         check_finite(s.x.iter().copied(), &format!("line_plot: series '{}' x", s.label))?;
         check_finite(s.y.iter().copied(), &format!("line_plot: series '{}' y", s.label))?;
         let logy = if s.secondary { opts.log_y2 } else { opts.log_y };
         if opts.log_x && s.x.iter().any(|&v| v <= 0.0) {
-            return Err(format!("line_plot: series '{}' has x <= 0 on a log axis", s.label));
+            return Err(Error::invalid(format!("line_plot: series '{}' has x <= 0 on a log axis", s.label)));
         }
         if logy && s.y.iter().any(|&v| v <= 0.0) {
-            return Err(format!("line_plot: series '{}' has y <= 0 on a log axis", s.label));
+            return Err(Error::invalid(format!("line_plot: series '{}' has y <= 0 on a log axis", s.label)));
         }
     }
     let has_y2 = series.iter().any(|s| s.secondary);
@@ -28,7 +29,7 @@ pub fn line_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &
         Some(r) => check_range(r, opts.log_x, "x")?,
         None => data_range(series.iter().flat_map(|s| s.x.iter().copied()), opts.log_x, if markers { 0.03 } else { 0.0 }).unwrap(),
     };
-    let yr_of = |sec: bool, log: bool, given: Option<(f64, f64)>, what: &str| -> Result<(f64, f64), String> {
+    let yr_of = |sec: bool, log: bool, given: Option<(f64, f64)>, what: &str| -> Result<(f64, f64), Error> {
         match given {
             Some(r) => check_range(r, log, what),
             None => Ok(data_range(series.iter().filter(|s| s.secondary == sec).flat_map(|s| s.y.iter().copied()), log, 0.05)
@@ -54,7 +55,7 @@ pub fn line_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, series: &
     let bottom = TICK_LEN + 4 + tick_h + if xlabel.is_empty() { 0 } else { 10 + label_h } + 15;
     let bx = BoxPx { l: left, t: top, r: w - right, b: h - bottom };
     if bx.r - bx.l < 50 || bx.b - bx.t < 50 {
-        return Err(format!("line_plot: {w}x{h} pixels is too small for the labels"));
+        return Err(Error::invalid(format!("line_plot: {w}x{h} pixels is too small for the labels")));
     }
     x.p0 = bx.l as f64;
     x.p1 = bx.r as f64;

@@ -1,5 +1,6 @@
 //! Colour maps of a scalar field on a triangle mesh, with colour bar.
 use super::*;
+use crate::error::Error;
 
 /// Plot box for a 2-D field: fills the available space, or the largest box with equal scales;
 /// then the canvas (w, h) loses the unused band, keeping at least `min_w` of width.
@@ -25,14 +26,14 @@ pub fn map_plot(
     tris: &[[[f64; 2]; 3]],
     values: &[[f64; 3]],
     opts: &MapOpts,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     ensure_font()?;
     check_size(opts.width, opts.height)?;
     if tris.is_empty() {
-        return Err("map_plot: no triangles".to_string());
+        return Err(Error::invalid("map_plot: no triangles"));
     }
     if tris.len() != values.len() {
-        return Err(format!("map_plot: {} triangles but {} value triples", tris.len(), values.len()));
+        return Err(Error::invalid(format!("map_plot: {} triangles but {} value triples", tris.len(), values.len())));
     }
     check_finite(tris.iter().flatten().flatten().copied(), "map_plot: coordinates")?;
     check_finite(values.iter().flatten().copied(), "map_plot: values")?;
@@ -88,7 +89,7 @@ pub fn map_plot(
     let bottom = TICK_LEN + 4 + tick_h + if xlabel.is_empty() { 0 } else { 10 + label_h } + 15;
     let avail = BoxPx { l: left, t: top, r: w - right, b: h - bottom };
     if avail.r - avail.l < 50 || avail.b - avail.t < 50 {
-        return Err(format!("map_plot: {w}x{h} pixels is too small for the labels"));
+        return Err(Error::invalid(format!("map_plot: {w}x{h} pixels is too small for the labels")));
     }
     let min_w = text_size(title, TITLE_SIZE).0 + 40;
     let (bx, w, h) = fit_box(avail, xr, yr, opts.equal_aspect, w, h, min_w);

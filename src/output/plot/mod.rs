@@ -11,6 +11,7 @@
 //! font cannot be read every plot function fails with an error naming the package.
 //!
 //! All input must be finite (and positive on a log axis); otherwise the functions return `Err`.
+use crate::error::Error;
 use ab_glyph::{Font, FontVec, PxScale, ScaleFont};
 use std::path::Path;
 use std::sync::OnceLock;
@@ -18,7 +19,7 @@ use std::sync::OnceLock;
 /// The TrueType font used for all text in plots.
 pub const FONT_PATH: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
-static FONT: OnceLock<Result<FontVec, String>> = OnceLock::new();
+static FONT: OnceLock<Result<FontVec, Error>> = OnceLock::new();
 static FONT_FILE: OnceLock<String> = OnceLock::new();
 
 /// Uses the TrueType font `path` instead of [`FONT_PATH`] (before the first plot; later
@@ -27,23 +28,23 @@ pub fn set_font_file(path: &str) {
     let _ = FONT_FILE.set(path.to_string());
 }
 
-fn load_font(path: &str) -> Result<FontVec, String> {
+fn load_font(path: &str) -> Result<FontVec, Error> {
     let bytes = std::fs::read(path).map_err(|e| {
-        format!(
+        Error::invalid(format!(
             "plot font '{path}' cannot be read ({e}): install the Debian package fonts-dejavu-core \
              (apt-get install fonts-dejavu-core) or give -ehl_plot_font FILE, a TrueType font file"
-        )
+        ))
     })?;
-    FontVec::try_from_vec(bytes).map_err(|_| format!("plot font '{path}' is not a valid TrueType font"))
+    FontVec::try_from_vec(bytes).map_err(|_| Error::invalid(format!("plot font '{path}' is not a valid TrueType font")))
 }
 
-fn font() -> Result<&'static FontVec, String> {
-    FONT.get_or_init(|| load_font(FONT_FILE.get().map_or(FONT_PATH, |f| f.as_str()))).as_ref().map_err(|e| e.clone())
+fn font() -> Result<&'static FontVec, Error> {
+    FONT.get_or_init(|| load_font(FONT_FILE.get().map_or(FONT_PATH, |f| f.as_str()))).as_ref().map_err(|e| Error::invalid(e.to_string()))
 }
 
 /// Loads the plot font once (from [`set_font_file`] or [`FONT_PATH`]); every plot function calls it
 /// first, so a missing font is an error before any drawing.
-pub fn ensure_font() -> Result<(), String> {
+pub fn ensure_font() -> Result<(), Error> {
     font().map(|_| ())
 }
 

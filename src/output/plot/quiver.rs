@@ -1,5 +1,6 @@
 //! Quiver (arrow) plots of a vector field.
 use super::*;
+use crate::error::Error;
 
 pub(super) fn draw_arrow(cv: &mut Canvas, tail: (f64, f64), tip: (f64, f64), c: Rgb, width: f64, clip: BoxPx) {
     let (dx, dy) = (tip.0 - tail.0, tip.1 - tail.1);
@@ -17,11 +18,11 @@ pub(super) fn draw_arrow(cv: &mut Canvas, tail: (f64, f64), tip: (f64, f64), c: 
 
 /// Arrow plot of a vector field: each entry is `[x, y, u, v]`; arrows are centred on (x, y).
 /// A reference arrow with its length in `opts.unit` is drawn under the plot.
-pub fn quiver_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, arrows: &[[f64; 4]], opts: &QuiverOpts) -> Result<(), String> {
+pub fn quiver_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, arrows: &[[f64; 4]], opts: &QuiverOpts) -> Result<(), Error> {
     ensure_font()?;
     check_size(opts.width, opts.height)?;
     if arrows.is_empty() {
-        return Err("quiver_plot: no arrows".to_string());
+        return Err(Error::invalid("quiver_plot: no arrows"));
     }
     check_finite(arrows.iter().flatten().copied(), "quiver_plot: arrows")?;
     if let Some(c) = opts.circle {
@@ -42,13 +43,13 @@ pub fn quiver_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, arrows:
     let vmax = arrows.iter().map(|a| a[2].hypot(a[3])).fold(0.0, f64::max);
     let scale = match opts.scale {
         Some(s) if s.is_finite() && s > 0.0 => s,
-        Some(s) => return Err(format!("quiver_plot: invalid scale {s}")),
+        Some(s) => return Err(Error::invalid(format!("quiver_plot: invalid scale {s}"))),
         None if vmax > 0.0 => 0.9 * spacing / vmax,
         None => 1.0,
     };
     let reference = match opts.reference {
         Some(r) if r.is_finite() && r > 0.0 => r,
-        Some(r) => return Err(format!("quiver_plot: invalid reference length {r}")),
+        Some(r) => return Err(Error::invalid(format!("quiver_plot: invalid reference length {r}"))),
         None if vmax > 0.0 => {
             let e = 10f64.powf(vmax.log10().floor());
             let m = vmax / e;
@@ -75,7 +76,7 @@ pub fn quiver_plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, arrows:
     let bottom = TICK_LEN + 4 + tick_h + if xlabel.is_empty() { 0 } else { 10 + label_h } + 15 + ref_row;
     let avail = BoxPx { l: left, t: top, r: w - right, b: h - bottom };
     if avail.r - avail.l < 50 || avail.b - avail.t < 50 {
-        return Err(format!("quiver_plot: {w}x{h} pixels is too small for the labels"));
+        return Err(Error::invalid(format!("quiver_plot: {w}x{h} pixels is too small for the labels")));
     }
     let min_w = text_size(title, TITLE_SIZE).0 + 40;
     let (bx, w, h) = fit_box(avail, xr, yr, opts.equal_aspect, w, h, min_w);

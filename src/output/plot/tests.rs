@@ -45,9 +45,9 @@ fn square_mesh(a: f64, n: usize, f: impl Fn(f64, f64) -> f64) -> (Vec<[[f64; 2];
 
 #[test]
 fn font_loads_or_names_the_package() {
-    let e = load_font("/nonexistent/DejaVuSans.ttf").err().unwrap();
+    let e = load_font("/nonexistent/DejaVuSans.ttf").err().unwrap().to_string();
     assert!(e.contains("fonts-dejavu-core"), "{e}");
-    let e = load_font("/etc/hostname").err().unwrap();
+    let e = load_font("/etc/hostname").err().unwrap().to_string();
     assert!(e.contains("not a valid TrueType"), "{e}");
     ensure_font().unwrap();
     let (w, h) = text_size("Pressure p [GPa]", LABEL_SIZE);
@@ -163,7 +163,7 @@ fn non_finite_and_bad_input_are_rejected() {
     for (k, b) in bad.iter().enumerate() {
         let s = vec![Series::new("a", vec![1.0, 2.0, 3.0], vec![1.0, *b, 2.0], Style::Line)];
         let p = d.join(format!("bad_line_{k}.png"));
-        let e = line_plot(&p, "t", "x", "y", &s, &LineOpts::default()).unwrap_err();
+        let e = line_plot(&p, "t", "x", "y", &s, &LineOpts::default()).unwrap_err().to_string();
         assert!(e.contains("finite"), "{e}");
         assert!(!p.exists());
         let tris = [[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]];
