@@ -4,7 +4,7 @@
 //!   ehl-summary compare REF.json NEW.json [--tolerances FILE] [--rel TOL]
 //!       prints a table of the keys that moved; exit 1 on drift (or a missing key)
 //!   ehl-summary get FILE.json KEY...        prints the values of dotted keys
-//!   ehl-summary hard OUTDIR CASE...         the hard suite's table (OUTDIR/hard.md); exit 1 on a failed check
+//!   ehl-summary hard OUTDIR CASE... [--change F]  the hard suite's table (OUTDIR/hard.md); exit 1 on a failed check
 use clap::{Parser, Subcommand};
 use ehl_petsc::error::{Error, ResultExt};
 use ehl_petsc::regress::{self, hard, Tolerances};
@@ -36,7 +36,14 @@ enum Cmd {
     /// Print the values of dotted keys (e.g. film.hc_m)
     Get { file: PathBuf, keys: Vec<String> },
     /// The hard suite's table from OUTDIR/CASE/{default,refined}/summary.json (and .wall, .log)
-    Hard { outdir: PathBuf, cases: Vec<String> },
+    Hard {
+        outdir: PathBuf,
+        cases: Vec<String>,
+        /// Largest relative change of hc and hm allowed between the pair (the accuracy target
+        /// for a target pair; default: the mesh pair's 2 %)
+        #[arg(long, default_value_t = hard::MESH_CHANGE)]
+        change: f64,
+    },
 }
 
 fn read_json(p: &Path) -> Result<serde_json::Value, Error> {
@@ -77,7 +84,7 @@ fn run(cli: Cli) -> Result<i32, Error> {
             }
             Ok(0)
         }
-        Cmd::Hard { outdir, cases } => {
+        Cmd::Hard { outdir, cases, change } => {
             let load = |case: &str, mesh: &str| -> hard::Run {
                 let base = outdir.join(case).join(mesh);
                 let wall_s =
@@ -95,7 +102,7 @@ fn run(cli: Cli) -> Result<i32, Error> {
             let mut md = String::from(hard::HEADER);
             let mut n_failed = 0;
             for case in &cases {
-                let (row, failed) = hard::check_case(case, &load(case, "default"), &load(case, "refined"));
+                let (row, failed) = hard::check_case(case, &load(case, "default"), &load(case, "refined"), change);
                 md.push_str(&row);
                 n_failed += usize::from(!failed.is_empty());
             }
