@@ -159,9 +159,16 @@ struct Newton<'a> {
     bt_after_domain: bool,
 }
 
+/// ICNTL(14) a failed factorisation is given: four times MUMPS's default of 20 %, once.
+/// Where that is not enough the matrix itself is the trouble: at M = 100, L = 20 on the
+/// 0.0625 a level the same Jacobian (alpha step, ninth iteration) lacked 40, 64 and 257
+/// million entries at 20, 80 and 320 %, and 1,280 % ran the machine out of memory (the
+/// kernel killed the run, with no result).
+const MUMPS_WORKSPACE_PERCENT: i64 = 80;
+
 /// After a MUMPS failure for want of workspace, sets `-mat_mumps_icntl_14` (percentage added
-/// to the analysis's estimate) to four times its value for the factorisations that follow,
-/// unless the user chose it; says what it did, for the log.
+/// to the analysis's estimate) to [`MUMPS_WORKSPACE_PERCENT`] for the factorisations that
+/// follow, unless the user chose it or it is there already; says what it did, for the log.
 fn more_mumps_workspace(why: &petsc::factor::LinearFailure) -> petsc::Result<String> {
     const KEY: &str = "-mat_mumps_icntl_14";
     let (true, Some(now)) = (why.mumps_workspace_too_small(), why.mumps_icntl14) else {
@@ -170,9 +177,11 @@ fn more_mumps_workspace(why: &petsc::factor::LinearFailure) -> petsc::Result<Str
     if petsc::options::user_set(KEY)? {
         return Ok(format!(" (your {KEY} {now} kept)"));
     }
-    let more = (4 * now).max(80);
-    petsc::options::set_ours(KEY, &more.to_string())?;
-    Ok(format!(" and MUMPS workspace {KEY} {more}"))
+    if now >= MUMPS_WORKSPACE_PERCENT {
+        return Ok(format!(" ({KEY} stays {now}: more workspace did not help this matrix where it was measured)"));
+    }
+    petsc::options::set_ours(KEY, &MUMPS_WORKSPACE_PERCENT.to_string())?;
+    Ok(format!(" and MUMPS workspace {KEY} {MUMPS_WORKSPACE_PERCENT}"))
 }
 
 impl Newton<'_> {
