@@ -51,4 +51,15 @@ fn a_finer_mesh_starts_from_a_coarser_solution() {
     assert_eq!(out.status.code(), Some(2), "{}", text(&out));
     assert!(text(&out).contains("face_pressure.csv has"), "{}", text(&out));
     assert!(!bad.exists());
+
+    // An adaptively refined run (more than one level in its accuracy report): its last
+    // level's mesh is not rebuilt from the scene, so it is refused with that reason.
+    std::fs::write(c_out.join("face_pressure.csv"), &csv).unwrap();
+    let mut s = summary(&c_out);
+    s["accuracy"] = serde_json::json!({"target": 0.01, "reached": true, "levels": [{}, {}, {}]});
+    std::fs::write(c_out.join("summary.json"), serde_json::to_string_pretty(&s).unwrap()).unwrap();
+    let out = mpirun(2, &[fine.as_str(), "--start-from", c_out.to_str().unwrap(), "--output", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(text(&out).contains("refined adaptively (3 levels)"), "{}", text(&out));
+    assert!(!bad.exists());
 }

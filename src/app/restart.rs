@@ -72,6 +72,14 @@ impl EarlierRun {
                 summary_path.display()
             ))));
         }
+        // An adaptively refined run's face pressure lives on its last level's mesh, which
+        // the scene alone does not rebuild (the levels' size fields are not stored).
+        if let Some(n) = value["accuracy"]["levels"].as_array().map(|l| l.len()).filter(|&n| n > 1) {
+            return Err(err(Error::invalid(format!(
+                "{} is the summary of a run refined adaptively ({n} levels): its last level's mesh cannot be rebuilt from the scene; start from a run on a fixed mesh (accuracy.target = 0)",
+                summary_path.display()
+            ))));
+        }
         let summary = Summary::from_json(&text).map_err(|e| {
             err(e.context(format!("{} is not the summary of a lubricated run this version can read", summary_path.display())))
         })?;
