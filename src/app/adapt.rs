@@ -206,6 +206,13 @@ fn next_field(mesh: &Mesh, edges: &[f64], marked: &[bool], growth: f64) -> SizeF
     f
 }
 
+/// How many times a first level that does not converge is solved again on a finer mesh
+/// (from 0.25 a: 0.125 a, then 0.0625 a in the Hertz zone).
+const FIRST_LEVEL_RETRIES: usize = 2;
+/// Radius (units of a) of the zone a retried first level halves: the Hertz circle with the
+/// outlet constriction and the side lobes (r up to about 1.1 a).
+const FIRST_RETRY_RADIUS: f64 = 1.3;
+
 /// A solved level kept for the next one: its setup, solution, dimensionless central film
 /// and condensation time.
 struct Solved {
@@ -232,7 +239,11 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let mut field: Option<Arc<SizeField>> = None;
     let mut previous: Option<Solved> = None;
     let growth = scene.mesh.growth;
-    for k in 0..=max_levels {
+    // Tries of the first level on a finer mesh after it failed on the scene's own.
+    let mut first_retries = 0;
+    loop {
+        // The level being solved: one per converged level (a retried first level stays 0).
+        let k = levels.len();
         let t0 = Instant::now();
         let setup = match Setup::with_size_field(ctx, scene, field.clone()) {
             Ok(s) => s,
@@ -277,7 +288,36 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 }
             }
             (None, Some(e)) => e.solve(ctx, scene, &solver)?,
-            (None, None) => solver.solve(ctx, scene, None)?,
+            (None, None) => match solver.solve(ctx, scene, None) {
+                Ok(sol) => sol,
+                // A first mesh too coarse for the film (at low speed or high load the side
+                // lobes and the outlet constriction are narrower than 0.25 a, and the film
+                // closes there on it: cases/hard/slow) is refined in the Hertz zone and
+                // solved again; a film that closes at a spin pole closes on any mesh.
+                Err(e)
+                    if crate::interrupt::agreed() == 0
+                        && first_retries < FIRST_LEVEL_RETRIES
+                        && !e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE) =>
+                {
+                    let edges = longest_edges(&setup.mesh);
+                    let marked: Vec<bool> = (0..setup.mesh.contact_tris.len())
+                        .map(|t| {
+                            let p = setup.mesh.contact_tri_xz(t);
+                            let c = [(p[0][0] + p[1][0] + p[2][0]) / 3.0, (p[0][1] + p[1][1] + p[2][1]) / 3.0];
+                            c[0].hypot(c[1]) <= FIRST_RETRY_RADIUS
+                        })
+                        .collect();
+                    let why = e.to_string();
+                    ctx.log(format!(
+                        "accuracy: the first level did not converge on its mesh ({}); again with the contact triangles within r <= {FIRST_RETRY_RADIUS} a halved",
+                        why.split("; path:").next().unwrap_or(&why)
+                    ));
+                    field = Some(Arc::new(next_field(&setup.mesh, &edges, &marked, growth)));
+                    first_retries += 1;
+                    continue;
+                }
+                Err(e) => return Err(e),
+            },
         };
         let fields = FieldsOnFace::new(&setup.mesh, &setup.layout, &sol.x);
         let st = fields.stats();
@@ -350,7 +390,6 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         }
         previous = Some(here);
     }
-    unreachable!("the loop returns at max_levels")
 }
 
 /// After level `k` stopped with `e`: when the time budget was spent (and a level converged

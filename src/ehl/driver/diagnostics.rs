@@ -4,6 +4,10 @@ use crate::ehl::layout::Layout;
 use crate::ehl::system::EhlSystem;
 use crate::petsc::{self, Matrix, Vector};
 
+/// Words of a failure whose film closed at a spin pole inside the Hertz circle: the model
+/// has no film there, on any mesh (a caller that would refine and retry checks for them).
+pub const POLE_COLLAPSE: &str = "next to the spin pole";
+
 /// A Newton solve stopped because the film closed.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Collapse {
@@ -21,7 +25,7 @@ impl Collapse {
         let zc = self.pole?;
         let [x, z] = self.at;
         (zc.abs() < 1.0 && x.hypot(z - zc) <= 0.25).then(|| {
-            format!("the film closes at ({x:.3}, {z:.3})a, next to the spin pole (0, {zc:.3})a inside the Hertz circle, where the mean surface velocity vanishes: the isothermal Reynolds equation has no entrainment there to carry a film (README \"Strong spin\")")
+            format!("the film closes at ({x:.3}, {z:.3})a, {POLE_COLLAPSE} (0, {zc:.3})a inside the Hertz circle, where the mean surface velocity vanishes: the isothermal Reynolds equation has no entrainment there to carry a film (README \"Strong spin\")")
         })
     }
 }

@@ -16,7 +16,7 @@ mod problem;
 mod start;
 
 use crate::error::Error;
-pub use diagnostics::check_jacobian;
+pub use diagnostics::{check_jacobian, POLE_COLLAPSE};
 use policy::Attempt;
 pub use policy::{set_newton_defaults, set_newton_linear_solver, Coupling, CONDENSED_PREFIX};
 pub use problem::{lambda_bar, lubricant, velocity_field};
