@@ -95,7 +95,15 @@ impl EarlierRun {
         let csv_path = dir.join(FACE_PRESSURE);
         let csv = crate::case::read_bounded(&csv_path, 256 << 20).map_err(|e| err(Error::reading(&csv_path)(e)))?;
         let a = scene.hertz().a;
-        let rows: Vec<&str> = csv.lines().skip(1).filter(|l| !l.trim().is_empty()).collect();
+        let (header, rows) =
+            crate::output::csv::parse_csv(&csv, &csv_path.display().to_string()).map_err(|e| err(Error::format(e.to_string())))?;
+        if header != ["x_m", "z_m", "p_pa"] {
+            return Err(err(Error::format(format!(
+                "{}: expected the columns x_m,z_m,p_pa, found {}",
+                csv_path.display(),
+                header.join(",")
+            ))));
+        }
         if rows.len() != mesh.contact_nodes.len() {
             return Err(err(Error::format(format!(
                 "{} has {} nodes, but the mesh of the earlier scene has {} contact nodes (written by another version of the mesher?)",
@@ -105,25 +113,20 @@ impl EarlierRun {
             ))));
         }
         let mut p_pa = vec![0.0; mesh.nodes.len()];
-        for (k, (row, &n)) in rows.iter().zip(&mesh.contact_nodes).enumerate() {
-            let v: Vec<f64> = row
-                .split(',')
-                .map(|w| w.trim().parse::<f64>())
-                .collect::<Result<_, _>>()
-                .map_err(|e| err(Error::format(format!("{} line {}: {e}", csv_path.display(), k + 2))))?;
-            if v.len() != 3 || !v.iter().all(|x| x.is_finite()) {
+        for (k, (v, &n)) in rows.iter().zip(&mesh.contact_nodes).enumerate() {
+            if !v.iter().all(|x| x.is_finite()) {
                 return Err(err(Error::format(format!(
-                    "{} line {}: expected three finite numbers x_m,z_m,p_pa",
+                    "{} data line {}: expected three finite numbers x_m,z_m,p_pa",
                     csv_path.display(),
-                    k + 2
+                    k + 1
                 ))));
             }
             let c = mesh.nodes[n as usize];
             if (v[0] / a - c[0]).abs() > 1e-9 || (v[1] / a - c[2]).abs() > 1e-9 {
                 return Err(err(Error::format(format!(
-                    "{} line {}: node at ({:.6}a, {:.6}a), but the earlier mesh has its contact node there at ({:.6}a, {:.6}a) (written by another version of the mesher?)",
+                    "{} data line {}: node at ({:.6}a, {:.6}a), but the earlier mesh has its contact node there at ({:.6}a, {:.6}a) (written by another version of the mesher?)",
                     csv_path.display(),
-                    k + 2,
+                    k + 1,
                     v[0] / a,
                     v[1] / a,
                     c[0],

@@ -20,10 +20,9 @@ fn read(path: &Path) -> Res<String> {
 
 /// A CSV file as rows of named columns (numbers where they parse).
 fn csv(path: &Path) -> Res<Vec<HashMap<String, String>>> {
-    let text = read(path)?;
-    let mut lines = text.lines();
-    let head: Vec<String> = lines.next().ok_or_else(|| Error::format("empty csv"))?.split(',').map(str::to_string).collect();
-    Ok(lines.map(|l| head.iter().cloned().zip(l.split(',').map(str::to_string)).collect()).collect())
+    let (head, rows) =
+        ehl_petsc::output::csv::parse_csv_cells(&read(path)?, &path.display().to_string()).map_err(|e| Error::format(e.to_string()))?;
+    Ok(rows.into_iter().map(|r| head.iter().cloned().zip(r).collect()).collect())
 }
 
 fn f(row: &HashMap<String, String>, key: &str) -> f64 {

@@ -92,20 +92,32 @@ fn split_line(line: &str) -> Vec<String> {
 
 /// Reads a table written by [`write_csv`]: header names and numeric rows.
 pub fn read_csv(path: &Path) -> io::Result<(Vec<String>, Vec<Vec<f64>>)> {
-    let text = std::fs::read_to_string(path)?;
+    parse_csv(&std::fs::read_to_string(path)?, &path.display().to_string())
+}
+
+/// A table's text (`name` for messages) as header names and rows of cells; blank lines are
+/// skipped, quoted cells keep their commas.
+pub fn parse_csv_cells(text: &str, name: &str) -> io::Result<(Vec<String>, Vec<Vec<String>>)> {
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-    let header = split_line(lines.next().ok_or_else(|| io::Error::new(io::ErrorKind::InvalidData, "csv: empty file"))?);
-    let mut rows = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let row = line
-            .split(',')
+    let header = split_line(lines.next().ok_or_else(|| io::Error::new(io::ErrorKind::InvalidData, format!("csv '{name}': empty file")))?);
+    Ok((header, lines.map(split_line).collect()))
+}
+
+/// A table's text (`name` for messages) as header names and numeric rows, each with as
+/// many values as the header; errors name the data line (1: the first after the header).
+pub fn parse_csv(text: &str, name: &str) -> io::Result<(Vec<String>, Vec<Vec<f64>>)> {
+    let (header, cells) = parse_csv_cells(text, name)?;
+    let mut rows = Vec::with_capacity(cells.len());
+    for (i, cells) in cells.iter().enumerate() {
+        let row = cells
+            .iter()
             .map(|s| s.trim().parse::<f64>())
             .collect::<Result<Vec<f64>, _>>()
-            .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("csv '{}': data line {}: {e}", path.display(), i + 1)))?;
+            .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("csv '{name}': data line {}: {e}", i + 1)))?;
         if row.len() != header.len() {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidData,
-                format!("csv '{}': data line {} has {} values, header has {}", path.display(), i + 1, row.len(), header.len()),
+                format!("csv '{name}': data line {} has {} values, header has {}", i + 1, row.len(), header.len()),
             ));
         }
         rows.push(row);
