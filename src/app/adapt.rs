@@ -288,16 +288,21 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 }
             }
             (None, Some(e)) => e.solve(ctx, scene, &solver)?,
-            (None, None) => match solver.solve(ctx, scene, None) {
+            (None, None) => match collective::agree(&ctx.world, solver.solve(ctx, scene, None)) {
                 Ok(sol) => sol,
                 // A first mesh too coarse for the film (at low speed or high load the side
                 // lobes and the outlet constriction are narrower than 0.25 a, and the film
                 // closes there on it: cases/hard/slow) is refined in the Hertz zone and
                 // solved again; a film that closes at a spin pole closes on any mesh.
+                // Every rank decides the same: only Newton's own failure (the same on every
+                // rank) is retried, not one rank's local fault.
                 Err(e)
                     if crate::interrupt::agreed() == 0
                         && first_retries < FIRST_LEVEL_RETRIES
-                        && !e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE) =>
+                        && collective::all(
+                            &ctx.world,
+                            matches!(e.root(), Error::NotConverged(_)) && !e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE),
+                        ) =>
                 {
                     let edges = longest_edges(&setup.mesh);
                     let marked: Vec<bool> = (0..setup.mesh.contact_tris.len())
