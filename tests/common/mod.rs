@@ -61,11 +61,31 @@ pub fn text(out: &Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
 }
 
-/// Reads a summary.json.
+/// Reads a summary.json. A lubricated run's summary (one with `film`) must also be read by
+/// the typed reader that `--start-from` and paper-findings use, so every test that reads one
+/// checks that the two agree on what the file holds.
 pub fn summary(dir: &Path) -> serde_json::Value {
     let path = dir.join("summary.json");
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    serde_json::from_str(&text).unwrap()
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    if v.get("film").is_some() {
+        let typed =
+            ehl_petsc::output::summary::Summary::from_json(&text).unwrap_or_else(|e| panic!("{}: typed reader: {e}", path.display()));
+        let same = |a: f64, b: Option<f64>| b.is_some_and(|b| a == b || (a.is_nan() && b.is_nan()));
+        assert!(
+            same(typed.film.hc_m, v["film"]["hc_m"].as_f64()),
+            "{}: typed film.hc_m {} against the file",
+            path.display(),
+            typed.film.hc_m
+        );
+        assert!(
+            same(typed.film.hm_m, v["film"]["hm_m"].as_f64()),
+            "{}: typed film.hm_m {} against the file",
+            path.display(),
+            typed.film.hm_m
+        );
+    }
+    v
 }
 
 /// Writes a scene file into `dir` and returns its path as a String.
