@@ -213,6 +213,17 @@ const FIRST_LEVEL_RETRIES: usize = 2;
 /// outlet constriction and the side lobes (r up to about 1.1 a).
 const FIRST_RETRY_RADIUS: f64 = 1.3;
 
+/// The contact triangles whose centroid lies within `radius` (units of a) of the contact
+/// centre.
+fn within_radius(mesh: &Mesh, radius: f64) -> Vec<bool> {
+    (0..mesh.contact_tris.len())
+        .map(|t| {
+            let p = mesh.contact_tri_xz(t);
+            ((p[0][0] + p[1][0] + p[2][0]) / 3.0).hypot((p[0][1] + p[1][1] + p[2][1]) / 3.0) <= radius
+        })
+        .collect()
+}
+
 /// A solved level kept for the next one: its setup, solution, dimensionless central film
 /// and condensation time.
 struct Solved {
@@ -305,13 +316,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         ) =>
                 {
                     let edges = longest_edges(&setup.mesh);
-                    let marked: Vec<bool> = (0..setup.mesh.contact_tris.len())
-                        .map(|t| {
-                            let p = setup.mesh.contact_tri_xz(t);
-                            let c = [(p[0][0] + p[1][0] + p[2][0]) / 3.0, (p[0][1] + p[1][1] + p[2][1]) / 3.0];
-                            c[0].hypot(c[1]) <= FIRST_RETRY_RADIUS
-                        })
-                        .collect();
+                    let marked = within_radius(&setup.mesh, FIRST_RETRY_RADIUS);
                     let why = e.to_string();
                     ctx.log(format!(
                         "accuracy: the first level did not converge on its mesh ({}); again with the contact triangles within r <= {FIRST_RETRY_RADIUS} a halved",
@@ -402,8 +407,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
 /// error (a signal, a failure outside Newton) stops the run.
 fn out_of_time(ctx: &Context, scene: &Scene, prev: Option<&Solved>, k: usize, levels: &[Level], e: Error) -> Result<(), Error> {
     match prev {
+        // (`finish` clears the spent budget before it writes.)
         Some(prev) if crate::interrupt::agreed() == crate::interrupt::DEADLINE => {
-            crate::interrupt::clear_deadline();
             let acc = scene.accuracy;
             let why = format!("the time budget accuracy.max_seconds = {} s was spent during level {k}", acc.max_seconds);
             let why = short_of(acc.target, &why, k - 1, levels.last().and_then(|l| l.est));

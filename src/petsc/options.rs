@@ -48,8 +48,7 @@ pub fn user_set(name: &str) -> Result<bool> {
 /// several systems (a convergence study switching from the condensed to the monolithic
 /// coupling needs MUMPS where the condensed path had set ScaLAPACK).
 pub fn set_ours(name: &str, value: &str) -> Result<()> {
-    let ours = OURS.lock().unwrap_or_else(|e| e.into_inner()).contains(name);
-    if has(name)? && !ours {
+    if user_set(name)? {
         return Ok(());
     }
     set_value(name, value)
