@@ -30,15 +30,15 @@ fn run_dry(name: &str, extra: &[&str]) -> (std::path::PathBuf, serde_json::Value
 
 /// Huber (Johnson Eq. 3.45) along the axis from the surface to 2 a: sigma_y (the normal
 /// stress, Johnson's sigma_z) and sigma_x = sigma_z (Johnson's sigma_r) within 1 % of p_H,
-/// surface point included (measured: at most 0.65 %, at the surface 0.27 %); the largest
-/// shear stress (Tresca / 2) within 1 % of Huber's maximum (0.310 p_H; measured -0.01 %) and
-/// its depth within 1 % of Huber's 0.481 a (measured 0.484 a).
+/// surface point included (measured: sigma_y 0.65 %, sigma_r 0.12 %); the largest shear
+/// stress (Tresca / 2) within 1 % of Huber's maximum (0.310 p_H; measured +0.1 %) and its
+/// depth within 1 % of Huber's 0.481 a (measured 0.484 a).
 #[test]
 fn dry_hertz_subsurface_matches_huber() {
     let (dir, s) = run_dry("subsurface-huber", &[]);
     let (a, ph) = (num(&s, "hertz.a_m"), num(&s, "hertz.ph_pa"));
     let csv = std::fs::read_to_string(dir.join("subsurface_axis.csv")).unwrap();
-    let mut rows = 0;
+    let (mut rows, mut worst_y, mut worst_r) = (0, 0.0f64, 0.0f64);
     for line in csv.lines().skip(1) {
         let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
         let d = v[0] / a;
@@ -53,9 +53,12 @@ fn dry_hertz_subsurface_matches_huber() {
             (sxx - sr).abs() < tol && (szz - sr).abs() < tol,
             "depth {d:.3} a: sigma_x = {sxx:.4}, sigma_z = {szz:.4} p_H, Huber sigma_r {sr:.4}"
         );
+        worst_y = worst_y.max((syy - sz).abs());
+        worst_r = worst_r.max((sxx - sr).abs().max((szz - sr).abs()));
         rows += 1;
     }
     assert!(rows > 150, "only {rows} axis samples above 2a");
+    eprintln!("axis to 2 a: largest error of sigma_y {:.3} %, of sigma_r {:.3} % of p_H", 100.0 * worst_y, 100.0 * worst_r);
     // Huber's maximum shear on the axis, by a fine search of the closed form.
     let (mut tmax, mut zmax) = (0.0, 0.0);
     for i in 1..20000 {
@@ -68,6 +71,7 @@ fn dry_hertz_subsurface_matches_huber() {
     }
     let tau = 0.5 * num(&s, "subsurface.tresca_max_pa") / ph;
     let depth = num(&s, "subsurface.tresca_max_depth_m") / a;
+    eprintln!("max shear {tau:.4} p_H at depth {depth:.4} a; Huber {tmax:.4} p_H at {zmax:.4} a");
     assert!((tau / tmax - 1.0).abs() < 0.01, "max shear {tau:.4} p_H vs Huber {tmax:.4} p_H");
     assert!((depth / zmax - 1.0).abs() < 0.01, "max shear at depth {depth:.3} a vs Huber {zmax:.3} a");
     // The maximum lies on the axis (the load is axisymmetric).
@@ -87,11 +91,11 @@ fn dry_hertz_subsurface_matches_huber() {
 }
 
 /// Hamilton (1983) with q = mu p in +x: the von Mises maximum on the plane of symmetry,
-/// value within 0.5 % (measured: 0.03 % for mu = 0.1 and 0.3, 0.1 % on a mesh twice as
-/// fine) and position within 0.02 a of Hamilton's (measured 0.004 a and 0.012 a; the
-/// maximum is flat, so its position scatters by 0.01-0.03 a between meshes of 0.125 a and
-/// finer, and the plain default mesh was 0.04 a off). The solver's frame maps Hamilton's
-/// (x, y, z) to (x, z, -y).
+/// value within 0.5 % (measured: 0.08 % for mu = 0.1, 0.05 % for mu = 0.3) and position
+/// within 2 % of its distance from the centre. The maximum is flat (within 1 % of its value
+/// over about +-0.17 a in x), so it is placed at the vertex of the quadratic fitted to the
+/// field near it, not at the largest sample. The solver's frame maps Hamilton's (x, y, z)
+/// to (x, z, -y).
 fn check_hamilton(mu: f64) {
     let m = mu.to_string();
     let (_, s) = run_dry(
@@ -115,7 +119,13 @@ fn check_hamilton(mu: f64) {
         "mu = {mu}: von Mises max {v:.4} p_H at x = {x:.4} a, depth {d:.4} a; Hamilton {vref:.4} at x = {xref:.4} a, depth {zref:.4} a"
     );
     assert!((v / vref - 1.0).abs() < 0.005, "mu = {mu}: von Mises max {v:.4} p_H vs Hamilton {vref:.4}");
-    assert!((x - xref).hypot(d - zref) < 0.02, "mu = {mu}: maximum at ({x:.3}, depth {d:.3}) a vs Hamilton ({xref:.3}, {zref:.3}) a");
+    // The position within 2 % of its distance from the contact centre (0.0098 a at mu = 0.1,
+    // 0.0107 a at mu = 0.3; measured 0.0027 a and 0.0044 a).
+    let off = (x - xref).hypot(d - zref);
+    assert!(
+        off < 0.02 * xref.hypot(zref),
+        "mu = {mu}: maximum at ({x:.4}, depth {d:.4}) a vs Hamilton ({xref:.4}, {zref:.4}) a: {off:.4} a apart"
+    );
     // Over the whole region the maximum is the same (the plane of symmetry holds it).
     let v3 = num(&s, "subsurface.von_mises_max_pa") / ph;
     assert!((v3 / v - 1.0).abs() < 0.01, "3D maximum {v3:.4} vs plane {v:.4}");

@@ -5,6 +5,8 @@
 //!       prints a table of the keys that moved; exit 1 on drift (or a missing key)
 //!   ehl-summary get FILE.json KEY...        prints the values of dotted keys
 //!   ehl-summary hard OUTDIR CASE... [--change F]  the hard suite's table (OUTDIR/hard.md); exit 1 on a failed check
+//!   ehl-summary curve DATA.csv OUT.png [--title T]  error against wall time, one line per
+//!       `series` of the CSV (columns series, seconds, error_pct), log-log
 use clap::{Parser, Subcommand};
 use ehl_petsc::error::{Error, ResultExt};
 use ehl_petsc::regress::{self, hard, Tolerances};
@@ -43,6 +45,14 @@ enum Cmd {
         /// for a target pair; default: the mesh pair's 2 %)
         #[arg(long, default_value_t = hard::MESH_CHANGE)]
         change: f64,
+    },
+    /// Plot error against wall time from a CSV (columns series, seconds, error_pct), one line
+    /// per series, log-log: an accuracy-time curve (docs/performance.md)
+    Curve {
+        data: PathBuf,
+        png: PathBuf,
+        #[arg(long, default_value = "relative error against wall time")]
+        title: String,
     },
 }
 
@@ -112,7 +122,47 @@ fn run(cli: Cli) -> Result<i32, Error> {
             std::fs::write(&path, &md).map_err(Error::writing(&path))?;
             Ok(if n_failed == 0 { 0 } else { 1 })
         }
+        Cmd::Curve { data, png, title } => {
+            let series = curve_series(&data)?;
+            let opts = ehl_petsc::output::plot::LineOpts { log_x: true, log_y: true, ..Default::default() };
+            ehl_petsc::output::plot::line_plot(&png, &title, "wall time (s)", "relative error (%)", &series, &opts)?;
+            println!("wrote {}", png.display());
+            Ok(0)
+        }
     }
+}
+
+/// The series of an accuracy-time CSV, in the order they first appear.
+fn curve_series(path: &Path) -> Result<Vec<ehl_petsc::output::plot::Series>, Error> {
+    use ehl_petsc::output::plot::{Series, Style};
+    let text = std::fs::read_to_string(path).map_err(Error::reading(path))?;
+    let (head, rows) =
+        ehl_petsc::output::csv::parse_csv_cells(&text, &path.display().to_string()).map_err(|e| Error::format(e.to_string()))?;
+    let col = |name: &str| {
+        head.iter()
+            .position(|h| h == name)
+            .ok_or_else(|| Error::format(format!("{}: no column '{name}' (need series, seconds, error_pct)", path.display())))
+    };
+    let (c_s, c_t, c_e) = (col("series")?, col("seconds")?, col("error_pct")?);
+    let mut series: Vec<Series> = Vec::new();
+    for (i, r) in rows.iter().enumerate() {
+        let num = |c: usize| {
+            r[c].trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| Error::format(format!("{} row {}: '{}' is not a positive number", path.display(), i + 2, r[c])))
+        };
+        let (t, e) = (num(c_t)?, num(c_e)?);
+        match series.iter_mut().find(|s| s.label == r[c_s]) {
+            Some(s) => {
+                s.x.push(t);
+                s.y.push(e);
+            }
+            None => series.push(Series::new(&r[c_s], vec![t], vec![e], Style::LinePoints)),
+        }
+    }
+    Ok(series)
 }
 
 fn main() {
