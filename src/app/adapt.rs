@@ -38,7 +38,7 @@ pub const MIN_ADAPTIVE_SIZE: f64 = 16.0 / 4096.0;
 
 /// A contact triangle with a nodal pressure above this (units of p_H) is in the
 /// pressurised zone, which every level refines. At 1e-3 the zone reaches far into the
-/// slow inlet build-up, where refining changes hc and hm by less than 1e-5: 1e-2 gives
+/// slow inlet build-up, where refining changes hc and hm by about 1e-5: 1e-2 gives
 /// the same films with 40 % fewer unknowns (docs/accuracy.md, "What a level refines").
 const PRESSURISED: f64 = 1e-2;
 

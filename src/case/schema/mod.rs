@@ -301,7 +301,7 @@ pub const ACCURACY_FIELDS: &[Field] = &[
         "",
         Kind::Number(Range::Closed(0.0, 0.9)),
         Presence::Default("0"),
-        note = "every level refines the pressurised zone (p > 0.01 p_H); marking elsewhere by the indicator was measured to leave hc and hm unchanged to 1e-5 at 1.6-2.7 times the unknowns (docs/accuracy.md)"
+        note = "every level refines the pressurised zone (p > 0.01 p_H); marking elsewhere by the indicator was measured to move hc and hm by less than 6e-5 at 1.6-2.7 times the unknowns (docs/accuracy.md)"
     ),
     f!(
         "max_unknowns",
