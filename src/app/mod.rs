@@ -4,6 +4,7 @@ pub mod adapt;
 pub mod cli;
 pub mod dry;
 pub mod lubricated;
+mod marking;
 pub mod plots;
 pub mod restart;
 pub mod study;

@@ -71,6 +71,18 @@ impl Ksp {
         Ok(its as usize)
     }
 
+    /// Solves A^T x = b (the adjoint; MUMPS solves it with the same factors) and checks
+    /// the converged reason.
+    pub fn solve_transpose(&self, b: &Vector, x: &Vector) -> Result<()> {
+        pcall!(ffi::KSPSolveTranspose(self.raw, b.raw, x.raw))?;
+        let mut reason: ffi::KSPConvergedReason = 0;
+        pcall!(ffi::KSPGetConvergedReason(self.raw, &mut reason))?;
+        if reason < 0 {
+            return Err(rust_error(format!("transposed linear solve failed: KSP reason {reason}")));
+        }
+        Ok(())
+    }
+
     /// Memory MUMPS used for the factorisation (MB, summed over the ranks: INFOG(22)),
     /// after a solve; None when the preconditioner is not a MUMPS factorisation.
     pub fn mumps_factor_mb(&self) -> Option<f64> {

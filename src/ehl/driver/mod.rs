@@ -9,6 +9,7 @@
 //! - `diagnostics`: why the film closed, the finite-difference Jacobian check.
 //!
 //! Developer options (`-ehl_...`, listed by `-help`) are read by [`crate::ehl_options`].
+mod adjoint;
 mod continuation;
 mod diagnostics;
 mod policy;

@@ -1,0 +1,194 @@
+//! What each level of the adaptive loop refines ([`super::adapt`]): the marking of the
+//! contact triangles, and the size field of the next level built from it.
+//!
+//! - Goal-oriented marking (`accuracy.marking` = theta > 0): the mass-flux residual of
+//!   each triangle weighted by how much it moves the target films (their adjoints), the
+//!   fewest triangles carrying the fraction theta of the total (Doerfler).
+//! - Zone marking (`accuracy.marking = 0`): every triangle of the pressurised zone.
+use super::adapt::MIN_ADAPTIVE_SIZE;
+use super::Context;
+use crate::case::Scene;
+use crate::ehl::driver::{self, EhlSolver};
+use crate::ehl::post::{FieldsOnFace, FilmStats};
+use crate::error::Error;
+use crate::mesh::size_field::SizeField;
+use crate::mesh::spec::dyadic_size;
+use crate::mesh::Mesh;
+use crate::reynolds::estimate::{dorfler_mark, element_residual};
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// A contact triangle with a nodal pressure above this (units of p_H) is in the
+/// pressurised zone, which every level refines. At 1e-3 the zone reaches far into the
+/// slow inlet build-up, where refining changes hc and hm by about 1e-5: 1e-2 gives
+/// the same films with 40 % fewer unknowns (docs/accuracy.md, "What a level refines").
+const PRESSURISED: f64 = 1e-2;
+
+/// The outward fluxes of an edge at its two Gauss points summed over its triangles, the
+/// triangles (one or two) and how many there are.
+type EdgeFluxes = ([f64; 2], [usize; 2], u8);
+
+/// The indicator of every contact triangle of a converged level (on every rank: each holds
+/// the whole iterate).
+pub(super) fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
+    let mesh = fields.mesh;
+    let lub = driver::lubricant(scene);
+    let fluid = lub.fluid(driver::lambda_bar(scene));
+    let vel = driver::velocity_field(scene);
+    let penalty = if scene.effects.cavitation == crate::case::CavitationModel::Penalty { scene.reynolds.penalty } else { 0.0 };
+    let n = mesh.contact_tris.len();
+    let mut eta = vec![0.0; n];
+    // Edge (low, high vertex id) -> outward fluxes at its Gauss points, ordered from the
+    // low to the high vertex, summed over the two triangles that share it.
+    let mut jumps: HashMap<(u32, u32), EdgeFluxes> = HashMap::new();
+    for (k, tri) in mesh.contact_tris.iter().enumerate() {
+        let verts = mesh.contact_tri_xz(k);
+        let p = tri.map(|n| fields.p_node(n));
+        let h = tri.map(|n| fields.h_node(n));
+        let v = verts.map(|x| vel(x[0], x[1]));
+        let r = element_residual(&verts, &p, &h, &v, &fluid, penalty);
+        eta[k] = r.interior;
+        for e in 0..3 {
+            let (a, b) = (tri[e], tri[(e + 1) % 3]);
+            let f = if a < b { r.edge_flux[e] } else { [r.edge_flux[e][1], r.edge_flux[e][0]] };
+            let entry = jumps.entry((a.min(b), a.max(b))).or_insert(([0.0; 2], [k, k], 0));
+            entry.0[0] += f[0];
+            entry.0[1] += f[1];
+            entry.1[entry.2 as usize % 2] = k;
+            entry.2 += 1;
+        }
+    }
+    for (sum, owners, count) in jumps.values() {
+        // Boundary edges (one owner) carry the Dirichlet condition: no jump.
+        if *count == 2 {
+            let j = sum[0].abs() + sum[1].abs();
+            eta[owners[0]] += 0.5 * j;
+            eta[owners[1]] += 0.5 * j;
+        }
+    }
+    eta
+}
+
+/// Length of the longest edge of every contact triangle (units of a).
+pub(super) fn longest_edges(mesh: &Mesh) -> Vec<f64> {
+    (0..mesh.contact_tris.len())
+        .map(|k| {
+            let p = mesh.contact_tri_xz(k);
+            (0..3).map(|e| (p[e][0] - p[(e + 1) % 3][0]).hypot(p[e][1] - p[(e + 1) % 3][1])).fold(0.0, f64::max)
+        })
+        .collect()
+}
+
+/// The size field of the next level: marked triangles at half their size, the others at
+/// theirs (a triangle of a Kuhn cell of size h has its longest edge h sqrt 2, or h one
+/// bisection further; both halve to h/2 and keep h). `edges`: [`longest_edges`].
+pub(super) fn next_field(mesh: &Mesh, edges: &[f64], marked: &[bool], growth: f64) -> SizeField {
+    let sizes: Vec<f64> =
+        edges.iter().zip(marked).map(|(&e, &m)| if m { dyadic_size(0.5 * e).max(MIN_ADAPTIVE_SIZE) } else { dyadic_size(e) }).collect();
+    let smallest = sizes.iter().cloned().fold(f64::INFINITY, f64::min);
+    let mut f = SizeField::new(mesh.spec.contact, 0.5 * smallest, growth, mesh.spec.contact_size);
+    for (k, &size) in sizes.iter().enumerate() {
+        f.impose_triangle(&mesh.contact_tri_xz(k), size);
+    }
+    f.grade();
+    f
+}
+
+/// The contact triangles whose centroid lies within `radius` (units of a) of the contact
+/// centre.
+pub(super) fn within_radius(mesh: &Mesh, radius: f64) -> Vec<bool> {
+    (0..mesh.contact_tris.len())
+        .map(|t| {
+            let p = mesh.contact_tri_xz(t);
+            ((p[0][0] + p[1][0] + p[2][0]) / 3.0).hypot((p[0][1] + p[1][1] + p[2][1]) / 3.0) <= radius
+        })
+        .collect()
+}
+
+/// The eligible triangles: those not yet at [`MIN_ADAPTIVE_SIZE`]. `edges`: [`longest_edges`].
+fn eligible(edges: &[f64]) -> Vec<bool> {
+    edges.iter().map(|&e| e > 1.5 * MIN_ADAPTIVE_SIZE).collect()
+}
+
+/// Zone marking (`accuracy.marking = 0`): every triangle of the pressurised zone, where hc
+/// and hm are carried (the film is transported from the inlet build-up through the Hertz
+/// zone to the side lobes and the outlet), so that a change between levels measures their
+/// error wherever it is made.
+pub(super) fn zone_mark(fields: &FieldsOnFace, edges: &[f64]) -> Vec<bool> {
+    let eligible = eligible(edges);
+    fields.mesh.contact_tris.iter().enumerate().map(|(t, tri)| eligible[t] && tri.iter().any(|&n| fields.p_node(n) > PRESSURISED)).collect()
+}
+
+/// Goal-oriented marking: each triangle's mass-flux indicator weighted by how much a flux
+/// error there moves each target film (its adjoint's hierarchical P2 surplus over the
+/// triangle's edges: the part of the adjoint the triangle's P1 interpolant misses),
+/// relative to that film, summed over the films; Doerfler marking at `theta`. The films
+/// are hc, hm and, with friction, the mean film over the Hertz circle (the shear stress
+/// is made there, and varies like 1/h).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn goal_mark(
+    ctx: &Context,
+    scene: &Scene,
+    solver: &EhlSolver,
+    x: &[f64],
+    fields: &FieldsOnFace,
+    st: &FilmStats,
+    edges: &[f64],
+    theta: f64,
+) -> Result<Vec<bool>, Error> {
+    let t0 = Instant::now();
+    let mesh = fields.mesh;
+    let at = |p: [f64; 2]| -> Result<Vec<(u32, f64)>, Error> {
+        let (t, b) = fields
+            .locate(p[0], p[1])
+            .ok_or_else(|| Error::numerical(format!("accuracy: ({}, {}) is not on the contact face", p[0], p[1])))?;
+        let phi = crate::fem::p2tri::p2_tri_basis_bary(b);
+        Ok(mesh.contact_tris[t].iter().zip(phi).map(|(&n, w)| (n, w)).collect())
+    };
+    let mut films = vec![(at([0.0, 0.0])?, st.hc), (at(st.hm_at)?, st.hm)];
+    if scene.effects.friction != crate::case::FrictionModel::Off {
+        films.push(mean_film_in_hertz_circle(fields));
+    }
+    let weights: Vec<Vec<(u32, f64)>> = films.iter().map(|f| f.0.clone()).collect();
+    let z = solver.film_adjoints(ctx, scene, x, &weights)?;
+    let rho = indicators(scene, fields);
+    let surplus = |z: &[f64], tri: &[u32; 6]| {
+        (0..3).map(|e| (z[tri[3 + e] as usize] - 0.5 * (z[tri[e] as usize] + z[tri[(e + 1) % 3] as usize])).abs()).fold(0.0, f64::max)
+    };
+    let eta: Vec<f64> = mesh
+        .contact_tris
+        .iter()
+        .enumerate()
+        .map(|(t, tri)| z.iter().zip(&films).map(|(z, f)| rho[t] * surplus(z, tri) / f.1.abs()).sum())
+        .collect();
+    let marked = dorfler_mark(&eta, &eligible(edges), theta);
+    ctx.log(format!(
+        "accuracy: goal-oriented marking ({} films): {} of {} contact triangles marked (fraction {theta} of the weighted indicator), {:.1} s",
+        films.len(),
+        marked.iter().filter(|&&m| m).count(),
+        marked.len(),
+        t0.elapsed().as_secs_f64()
+    ));
+    Ok(marked)
+}
+
+/// The mean film over the Hertz circle as nodal weights (each contact triangle whose
+/// centroid lies inside, with its P2 load weights), and its value.
+fn mean_film_in_hertz_circle(fields: &FieldsOnFace) -> (Vec<(u32, f64)>, f64) {
+    let mesh = fields.mesh;
+    // Ordered, so that every rank sums the same way and marks the same triangles.
+    let mut w: std::collections::BTreeMap<u32, f64> = std::collections::BTreeMap::new();
+    for (k, tri) in mesh.contact_tris.iter().enumerate() {
+        let v = mesh.contact_tri_xz(k);
+        if ((v[0][0] + v[1][0] + v[2][0]) / 3.0).hypot((v[0][1] + v[1][1] + v[2][1]) / 3.0) < 1.0 {
+            let lw = crate::fem::p2tri::p2_tri_weights(crate::fem::p2tri::tri_area(&v));
+            for (i, &n) in tri.iter().enumerate() {
+                *w.entry(n).or_insert(0.0) += lw[i];
+            }
+        }
+    }
+    let total: f64 = w.values().sum();
+    let weights: Vec<(u32, f64)> = w.into_iter().map(|(n, v)| (n, v / total)).collect();
+    let mean = weights.iter().map(|&(n, v)| v * fields.h_node(n)).sum();
+    (weights, mean)
+}
