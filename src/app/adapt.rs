@@ -320,7 +320,15 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // The next level's marking, while this level's fields are at hand (not when it is the last).
         let marked = if !reached && k < max_levels {
             Some(if acc.marking > 0.0 {
-                goal_mark(ctx, scene, &solver, &sol.x, &fields, &st, &edges, acc.marking)?
+                // A failed adjoint solve costs this level's goal-oriented marking, not the run
+                // (an interruption is acted on at the check after the marking).
+                match collective::agree(&ctx.world, goal_mark(ctx, scene, &solver, &sol.x, &fields, &st, &edges, acc.marking)) {
+                    Ok(m) => m,
+                    Err(e) => {
+                        ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
+                        zone_mark(&fields, &edges)
+                    }
+                }
             } else {
                 zone_mark(&fields, &edges)
             })

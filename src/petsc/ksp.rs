@@ -63,12 +63,27 @@ impl Ksp {
         let mut its: ffi::PetscInt = 0;
         pcall!(ffi::KSPGetIterationNumber(self.raw, &mut its))?;
         if reason < 0 {
-            let mut s: *const std::os::raw::c_char = std::ptr::null();
-            unsafe { ffi::KSPGetConvergedReasonString(self.raw, &mut s) };
-            let name = if s.is_null() { reason.to_string() } else { unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned() };
-            return Err(rust_error(format!("linear solve failed: KSP reason {name} after {its} iterations")));
+            // The factorisation's own cause (MUMPS's INFOG) when there is one.
+            let why = super::factor::last_failure(self.raw).map_or_else(|_| reason.to_string(), |f| f.to_string());
+            return Err(rust_error(format!("linear solve failed: {why} after {its} iterations")));
         }
         Ok(its as usize)
+    }
+
+    /// Solves A x = b once with a fresh solver for `a` under `prefix`; when MUMPS stops
+    /// because a workspace its analysis estimated was too small (INFOG(1) = -9 and the like:
+    /// it happens to an elastic Cholesky on some graded meshes), once more with
+    /// `-{prefix}mat_mumps_icntl_14 80`, unless the user chose that option.
+    pub fn solve_once_more_with_workspace(comm: ffi::MPI_Comm, a: &Matrix, prefix: &str, b: &Vector, x: &Vector) -> Result<()> {
+        let ksp = Ksp::with_prefix(comm, a, prefix)?;
+        let Err(e) = ksp.solve(b, x) else { return Ok(()) };
+        let key = format!("-{prefix}mat_mumps_icntl_14");
+        if !super::factor::last_failure(ksp.raw)?.mumps_workspace_too_small() || options::user_set(&key)? {
+            return Err(e);
+        }
+        drop(ksp);
+        options::set_ours(&key, "80")?;
+        Ksp::with_prefix(comm, a, prefix)?.solve(b, x).map(|_| ())
     }
 
     /// Solves A^T x = b (the adjoint; MUMPS solves it with the same factors) and checks

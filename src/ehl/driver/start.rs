@@ -74,9 +74,8 @@ pub(super) fn elastic_start(
     for (k, v) in [("ksp_type", "preonly"), ("pc_type", "cholesky"), ("pc_factor_mat_solver_type", "mumps"), ("mat_mumps_icntl_7", "4")] {
         petsc::options::set_default(&format!("-{START_PREFIX}{k}"), v)?;
     }
-    let ksp = Ksp::with_prefix(comm, k, START_PREFIX)?;
     let u = Vector::new(comm, dofs.local(ctx.rank))?;
-    ksp.solve(&b, &u)?;
+    Ksp::solve_once_more_with_workspace(comm, k, START_PREFIX, &b, &u)?;
     u.gather_all()
 }
 
