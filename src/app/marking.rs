@@ -178,13 +178,11 @@ fn mean_film_in_hertz_circle(fields: &FieldsOnFace) -> (Vec<(u32, f64)>, f64) {
     let mesh = fields.mesh;
     // Ordered, so that every rank sums the same way and marks the same triangles.
     let mut w: std::collections::BTreeMap<u32, f64> = std::collections::BTreeMap::new();
-    for (k, tri) in mesh.contact_tris.iter().enumerate() {
-        let v = mesh.contact_tri_xz(k);
-        if ((v[0][0] + v[1][0] + v[2][0]) / 3.0).hypot((v[0][1] + v[1][1] + v[2][1]) / 3.0) < 1.0 {
-            let lw = crate::fem::p2tri::p2_tri_weights(crate::fem::p2tri::tri_area(&v));
-            for (i, &n) in tri.iter().enumerate() {
-                *w.entry(n).or_insert(0.0) += lw[i];
-            }
+    let inside = within_radius(mesh, 1.0);
+    for (k, tri) in mesh.contact_tris.iter().enumerate().filter(|&(k, _)| inside[k]) {
+        let lw = crate::fem::p2tri::p2_tri_weights(crate::fem::p2tri::tri_area(&mesh.contact_tri_xz(k)));
+        for (i, &n) in tri.iter().enumerate() {
+            *w.entry(n).or_insert(0.0) += lw[i];
         }
     }
     let total: f64 = w.values().sum();
