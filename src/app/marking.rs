@@ -15,7 +15,7 @@ use crate::mesh::size_field::SizeField;
 use crate::mesh::spec::dyadic_size;
 use crate::mesh::Mesh;
 use crate::reynolds::estimate::{dorfler_mark, element_residual};
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 use std::time::Instant;
 
 /// A contact triangle with a nodal pressure above this (units of p_H) is in the
@@ -40,7 +40,9 @@ pub(super) fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
     let mut eta = vec![0.0; n];
     // Edge (low, high vertex id) -> outward fluxes at its Gauss points, ordered from the
     // low to the high vertex, summed over the two triangles that share it.
-    let mut jumps: HashMap<(u32, u32), EdgeFluxes> = HashMap::new();
+    // Ordered: every rank adds the jumps in the same order, so the indicators, and the
+    // marking every rank meshes from, agree to the last bit.
+    let mut jumps: BTreeMap<(u32, u32), EdgeFluxes> = BTreeMap::new();
     for (k, tri) in mesh.contact_tris.iter().enumerate() {
         let verts = mesh.contact_tri_xz(k);
         let p = tri.map(|n| fields.p_node(n));
@@ -177,7 +179,7 @@ pub(super) fn goal_mark(
 fn mean_film_in_hertz_circle(fields: &FieldsOnFace) -> (Vec<(u32, f64)>, f64) {
     let mesh = fields.mesh;
     // Ordered, so that every rank sums the same way and marks the same triangles.
-    let mut w: std::collections::BTreeMap<u32, f64> = std::collections::BTreeMap::new();
+    let mut w: BTreeMap<u32, f64> = BTreeMap::new();
     let inside = within_radius(mesh, 1.0);
     for (k, tri) in mesh.contact_tris.iter().enumerate().filter(|&(k, _)| inside[k]) {
         let lw = crate::fem::p2tri::p2_tri_weights(crate::fem::p2tri::tri_area(&mesh.contact_tri_xz(k)));
