@@ -194,6 +194,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let growth = scene.mesh.growth;
     // Tries of the first level on a finer mesh after it failed on the scene's own.
     let mut first_retries = 0;
+    // The level that may be meshed again with zone marking if it does not converge on its
+    // goal-oriented mesh.
+    let mut zone_retry: Option<usize> = None;
     loop {
         // The level being solved: one per converged level (a retried first level stays 0).
         let k = levels.len();
@@ -227,6 +230,22 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 );
                 match solved {
                     Ok(sol) => sol,
+                    // A goal-oriented level that does not converge is meshed again with the
+                    // previous level's whole pressurised zone refined, once: at M = 100,
+                    // L = 20 the continuation stalled at alpha 62.6 of 68.3 GPa^-1 on the
+                    // goal-oriented 0.125 a level and converged on the zone's.
+                    Err(e) if crate::interrupt::agreed() == 0 && zone_retry == Some(k) => {
+                        ctx.log(format!(
+                            "accuracy: level {k} did not converge on its goal-oriented mesh ({}); again with level {}'s pressurised zone refined",
+                            e.to_string().split("; path:").next().unwrap_or_default(),
+                            k - 1
+                        ));
+                        let edges = longest_edges(&prev.setup.mesh);
+                        let marked = zone_mark(&pf, &edges);
+                        field = Some(Arc::new(next_field(&prev.setup.mesh, &edges, &marked, growth)));
+                        zone_retry = None;
+                        continue;
+                    }
                     // A level that does not converge leaves the last converged one as the
                     // result, labelled as short of its target (an interruption stops).
                     Err(e) if crate::interrupt::agreed() == 0 => {
@@ -323,7 +342,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 // A failed adjoint solve costs this level's goal-oriented marking, not the run
                 // (an interruption is acted on at the check after the marking).
                 match collective::agree(&ctx.world, goal_mark(ctx, scene, &solver, &sol.x, &fields, &st, &edges, acc.marking)) {
-                    Ok(m) => m,
+                    Ok(m) => {
+                        zone_retry = Some(k + 1);
+                        m
+                    }
                     Err(e) => {
                         ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
                         zone_mark(&fields, &edges)
