@@ -151,7 +151,7 @@ pub(super) fn goal_mark(
     if scene.effects.friction != crate::case::FrictionModel::Off {
         films.push(mean_film_in_hertz_circle(fields));
     }
-    let weights: Vec<Vec<(u32, f64)>> = films.iter().map(|f| f.0.clone()).collect();
+    let (weights, values): (Vec<Vec<(u32, f64)>>, Vec<f64>) = films.into_iter().unzip();
     let z = solver.film_adjoints(ctx, scene, x, &weights)?;
     let rho = indicators(scene, fields);
     let surplus = |z: &[f64], tri: &[u32; 6]| {
@@ -161,12 +161,12 @@ pub(super) fn goal_mark(
         .contact_tris
         .iter()
         .enumerate()
-        .map(|(t, tri)| z.iter().zip(&films).map(|(z, f)| rho[t] * surplus(z, tri) / f.1.abs()).sum())
+        .map(|(t, tri)| z.iter().zip(&values).map(|(z, v)| rho[t] * surplus(z, tri) / v.abs()).sum())
         .collect();
     let marked = dorfler_mark(&eta, &eligible(edges), theta);
     ctx.log(format!(
         "accuracy: goal-oriented marking ({} films): {} of {} contact triangles marked (fraction {theta} of the weighted indicator), {:.1} s",
-        films.len(),
+        values.len(),
         marked.iter().filter(|&&m| m).count(),
         marked.len(),
         t0.elapsed().as_secs_f64()

@@ -51,6 +51,13 @@ pub fn mumps_workspace_code(infog1: i64) -> bool {
     matches!(infog1, -8 | -9 | -11 | -12 | -14 | -15 | -17 | -20)
 }
 
+/// ICNTL(14) a factorisation that failed for want of workspace is given: four times
+/// MUMPS's default of 20 %, once. Where that is not enough the matrix itself is the
+/// trouble: at M = 100, L = 20 on the 0.0625 a level the same Jacobian (alpha step, ninth
+/// iteration) lacked 40, 64 and 257 million entries at 20, 80 and 320 %, and 1,280 % ran the
+/// machine out of memory (the kernel killed the run, with no result).
+pub const MUMPS_WORKSPACE_PERCENT: i64 = 80;
+
 /// MUMPS error codes that mean the memory itself ran out: -13 (an allocation failed) and -19
 /// (the limit ICNTL(23)). No other matrix of the same pattern factorises either.
 pub fn mumps_memory_code(infog1: i64) -> bool {

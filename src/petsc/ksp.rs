@@ -58,14 +58,19 @@ impl Ksp {
     /// Solves A x = b and checks the converged reason (a failed solve is an error).
     pub fn solve(&self, b: &Vector, x: &Vector) -> Result<usize> {
         pcall!(ffi::KSPSolve(self.raw, b.raw, x.raw))?;
+        self.outcome("linear solve")
+    }
+
+    /// The iterations of the last solve, or an error naming why it failed (the KSP reason
+    /// and the factorisation's own cause, MUMPS's INFOG, when there is one).
+    fn outcome(&self, what: &str) -> Result<usize> {
         let mut reason: ffi::KSPConvergedReason = 0;
         pcall!(ffi::KSPGetConvergedReason(self.raw, &mut reason))?;
         let mut its: ffi::PetscInt = 0;
         pcall!(ffi::KSPGetIterationNumber(self.raw, &mut its))?;
         if reason < 0 {
-            // The factorisation's own cause (MUMPS's INFOG) when there is one.
             let why = super::factor::last_failure(self.raw).map_or_else(|_| reason.to_string(), |f| f.to_string());
-            return Err(rust_error(format!("linear solve failed: {why} after {its} iterations")));
+            return Err(rust_error(format!("{what} failed: {why} after {its} iterations")));
         }
         Ok(its as usize)
     }
@@ -73,7 +78,8 @@ impl Ksp {
     /// Solves A x = b once with a fresh solver for `a` under `prefix`; when MUMPS stops
     /// because a workspace its analysis estimated was too small (INFOG(1) = -9 and the like:
     /// it happens to an elastic Cholesky on some graded meshes), once more with
-    /// `-{prefix}mat_mumps_icntl_14 80`, unless the user chose that option.
+    /// `-{prefix}mat_mumps_icntl_14` at [`super::factor::MUMPS_WORKSPACE_PERCENT`], unless
+    /// the user chose that option.
     pub fn solve_once_more_with_workspace(comm: ffi::MPI_Comm, a: &Matrix, prefix: &str, b: &Vector, x: &Vector) -> Result<()> {
         let ksp = Ksp::with_prefix(comm, a, prefix)?;
         let Err(e) = ksp.solve(b, x) else { return Ok(()) };
@@ -82,7 +88,7 @@ impl Ksp {
             return Err(e);
         }
         drop(ksp);
-        options::set_ours(&key, "80")?;
+        options::set_ours(&key, &super::factor::MUMPS_WORKSPACE_PERCENT.to_string())?;
         Ksp::with_prefix(comm, a, prefix)?.solve(b, x).map(|_| ())
     }
 
@@ -90,12 +96,7 @@ impl Ksp {
     /// the converged reason.
     pub fn solve_transpose(&self, b: &Vector, x: &Vector) -> Result<()> {
         pcall!(ffi::KSPSolveTranspose(self.raw, b.raw, x.raw))?;
-        let mut reason: ffi::KSPConvergedReason = 0;
-        pcall!(ffi::KSPGetConvergedReason(self.raw, &mut reason))?;
-        if reason < 0 {
-            return Err(rust_error(format!("transposed linear solve failed: KSP reason {reason}")));
-        }
-        Ok(())
+        self.outcome("transposed linear solve").map(|_| ())
     }
 
     /// Memory MUMPS used for the factorisation (MB, summed over the ranks: INFOG(22)),

@@ -12,6 +12,7 @@ use crate::case::Scene;
 use crate::context::Context;
 use crate::ehl::system::EhlProblem;
 use crate::error::Error;
+use crate::petsc::factor::MUMPS_WORKSPACE_PERCENT;
 use crate::petsc::snes::{Snes, SolveReport};
 use crate::petsc::{self, Matrix, Vector};
 
@@ -158,13 +159,6 @@ struct Newton<'a> {
     /// line search ([`Policy::bt_after_domain_error`]).
     bt_after_domain: bool,
 }
-
-/// ICNTL(14) a failed factorisation is given: four times MUMPS's default of 20 %, once.
-/// Where that is not enough the matrix itself is the trouble: at M = 100, L = 20 on the
-/// 0.0625 a level the same Jacobian (alpha step, ninth iteration) lacked 40, 64 and 257
-/// million entries at 20, 80 and 320 %, and 1,280 % ran the machine out of memory (the
-/// kernel killed the run, with no result).
-const MUMPS_WORKSPACE_PERCENT: i64 = 80;
 
 /// After a MUMPS failure for want of workspace, sets `-mat_mumps_icntl_14` (percentage added
 /// to the analysis's estimate) to [`MUMPS_WORKSPACE_PERCENT`] for the factorisations that
