@@ -6,24 +6,46 @@ use common::*;
 /// Runs the M = 10, L = 6 example from a 0.5 a first mesh to target 0.05 on 2 ranks, with one
 /// more `--set KEY=VALUE`, in `scratch(name)/run`; returns the run and its summary (Null
 /// when none was written).
-fn moes_m10(name: &str, set: &str) -> (std::process::Output, serde_json::Value) {
+fn moes_m10(name: &str, set: &[&str]) -> (std::process::Output, serde_json::Value) {
     let dir = scratch(name);
     let scene = repo().join("cases/examples/moes-m10-l6.toml");
     let run = dir.join("run");
-    let args = [
-        scene.to_str().unwrap(),
-        "--output",
-        run.to_str().unwrap(),
-        "--set",
-        "accuracy.target=0.05",
-        "--set",
-        set,
-        "--set",
-        "mesh.contact_size=0.5",
-    ];
+    let args =
+        [scene.to_str().unwrap(), "--output", run.to_str().unwrap(), "--set", "accuracy.target=0.05", "--set", "mesh.contact_size=0.5"];
+    let args: Vec<&str> = args.into_iter().chain(set.iter().flat_map(|s| ["--set", s])).collect();
     let out = mpirun(2, &args);
     let summary = std::fs::read_to_string(run.join("summary.json")).map_or(serde_json::Value::Null, |t| serde_json::from_str(&t).unwrap());
     (out, summary)
+}
+
+/// The adjoints of hc and hm, checked against two more solves: the films' exponents in
+/// eta_R Ue from the adjoints (`output.speed_exponents`: -z . dF/d ln lambda_bar / J) equal
+/// the central difference of ln hc and ln hm over Ue (1.01)^(+-1) on the same fixed mesh.
+/// The adjoint gives the derivative of the discrete solution itself, so only the
+/// difference's truncation ((ln 1.01)^2 / 6 times the third log-derivative, about 2e-5) and
+/// Newton's tolerance separate them (measured: 1e-5 at 0.5 a and 0.25 a); 1e-3 allows for
+/// both. The exponents themselves lie near Hamrock and Dowson's 0.67 and 0.68.
+#[test]
+fn the_film_adjoints_predict_how_the_films_change_with_speed() {
+    let dir = scratch("accuracy_adjoint");
+    let scene = repo().join("cases/examples/moes-m10-l6.toml");
+    let solve = |name: &str, ue: f64| {
+        let run = dir.join(name);
+        let ue = format!("operating.entrainment_speed={ue}");
+        let args = [scene.to_str().unwrap(), "--output", run.to_str().unwrap(), "--set", &ue, "--set", "mesh.contact_size=0.5"];
+        let args: Vec<&str> = args.into_iter().chain(["--set", "output.speed_exponents=true", "--set", "output.png=false"]).collect();
+        let out = mpirun(2, &args);
+        assert!(out.status.success(), "{}", text(&out));
+        summary(&run)
+    };
+    let s = solve("at", 2.0);
+    let (up, down) = (solve("up", 2.0 * 1.01), solve("down", 2.0 / 1.01));
+    for (q, key) in [("hc", "film.hc_m"), ("hm", "film.hm_m")] {
+        let adjoint = s["speed_exponents"][q].as_f64().unwrap_or_else(|| panic!("{}", s["speed_exponents"]));
+        let difference = (num(&up, key) / num(&down, key)).ln() / (2.0 * 1.01f64.ln());
+        assert!((adjoint - difference).abs() < 1e-3, "{q}: adjoint {adjoint}, difference of two solves {difference}");
+        assert!((0.5..0.8).contains(&adjoint), "{q}: {adjoint}");
+    }
 }
 
 /// A lightly loaded Moes point (M = 10, L = 6, Barus, incompressible) on a coarse first mesh
@@ -34,7 +56,7 @@ fn moes_m10(name: &str, set: &str) -> (std::process::Output, serde_json::Value) 
 /// hm 0.3126 um (Venner-Lubrecht full multigrid, 1025^2, extrapolated).
 #[test]
 fn a_moes_point_is_refined_to_its_target() {
-    let (out, s) = moes_m10("accuracy_moes", "accuracy.max_levels=4");
+    let (out, s) = moes_m10("accuracy_moes", &["accuracy.max_levels=4", "output.speed_exponents=true"]);
     assert!(out.status.success(), "{}", text(&out));
     let acc = &s["accuracy"];
     assert_eq!(acc["reached"], true, "{acc}");
@@ -51,6 +73,12 @@ fn a_moes_point_is_refined_to_its_target() {
     assert!((hm / 0.3126e-6 - 1.0).abs() < 0.06, "hm {hm}");
     let log = text(&out);
     assert!(log.contains("accuracy: level 2"), "{log}");
+    // The last level's speed exponents come from the adjoint that also marks (checked
+    // against two solves in `the_film_adjoints_predict_how_the_films_change_with_speed`).
+    for q in ["hc", "hm"] {
+        let e = s["speed_exponents"][q].as_f64().unwrap_or_else(|| panic!("{}", s["speed_exponents"]));
+        assert!((0.5..0.8).contains(&e), "{q}: {e}");
+    }
     // Smooth fields: the transverse centre line X = 0 crosses no spike, so its largest
     // slope jump between neighbouring triangles measures node-to-node wiggles. A smooth
     // P2 pressure has jumps of order h^2 |P'''| (about 0.05-0.1 p_H/a at 0.125 a for a
@@ -79,7 +107,7 @@ fn a_target_is_refused_where_it_cannot_apply() {
 /// level 2 about 48,000 (goal-oriented marking), so a budget of 35,000 stops after level 1.
 #[test]
 fn a_level_over_the_unknowns_budget_is_not_solved_and_the_run_says_so() {
-    let (out, s) = moes_m10("accuracy_budget", "accuracy.max_unknowns=35000");
+    let (out, s) = moes_m10("accuracy_budget", &["accuracy.max_unknowns=35000"]);
     let log = text(&out);
     assert_eq!(out.status.code(), Some(4), "{log}");
     assert!(log.contains("accuracy.max_unknowns = 35000") && log.contains("not reached"), "{log}");
@@ -98,7 +126,7 @@ fn a_level_over_the_unknowns_budget_is_not_solved_and_the_run_says_so() {
 /// its first check and level 0's film is the result.
 #[test]
 fn a_spent_time_budget_writes_the_last_converged_level_and_says_so() {
-    let (out, s) = moes_m10("accuracy_time_budget", "accuracy.max_seconds=1");
+    let (out, s) = moes_m10("accuracy_time_budget", &["accuracy.max_seconds=1"]);
     let log = text(&out);
     assert_eq!(out.status.code(), Some(4), "{log}");
     assert!(log.contains("accuracy.max_seconds = 1 s was spent during level 1") && log.contains("not reached"), "{log}");

@@ -173,6 +173,8 @@ struct Solved {
     sol: EhlSolution,
     hc: f64,
     condensation_s: Option<f64>,
+    /// `speed_exponents` of summary.json, when the scene asks for them.
+    exponents: Option<serde_json::Value>,
 }
 
 /// Runs the adaptive loop of a lubricated single-point scene with `accuracy.target > 0`.
@@ -336,12 +338,21 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             level.est.map_or("- (first level)".to_string(), |e| e.describe())
         ));
         let reached = k >= 2 && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
-        // The next level's marking, while this level's fields are at hand (not when it is the last).
+        // The next level's marking, while this level's fields are at hand (not when it is the
+        // last), and the speed exponents when asked for: both from one adjoint LU.
+        let goal = !reached && k < max_levels && acc.marking > 0.0;
+        let mut adjoint = (goal || scene.output.speed_exponents).then(|| collective::agree(&ctx.world, solver.adjoint(ctx, scene, &sol.x)));
+        let exponents = match (&mut adjoint, scene.output.speed_exponents) {
+            (Some(Ok(a)), true) => Some(collective::agree(&ctx.world, super::sensitivity::speed_exponents(ctx, a, &fields, &st))),
+            (Some(Err(e)), true) => Some(Err(Error::numerical(format!("the adjoint failed: {e}")))),
+            _ => None,
+        };
+        let exponents = exponents.map(|got| super::sensitivity::report(ctx, got));
         let marked = if !reached && k < max_levels {
-            Some(if acc.marking > 0.0 {
-                // A failed adjoint solve costs this level's goal-oriented marking, not the run
-                // (an interruption is acted on at the check after the marking).
-                match collective::agree(&ctx.world, goal_mark(ctx, scene, &solver, &sol.x, &fields, &st, &edges, acc.marking)) {
+            Some(match adjoint.as_ref().filter(|_| goal) {
+                // A failed adjoint costs this level's goal-oriented marking, not the run (an
+                // interruption is acted on at the check after the marking).
+                Some(Ok(a)) => match collective::agree(&ctx.world, goal_mark(ctx, scene, a, &fields, &st, &edges, acc.marking)) {
                     Ok(m) => {
                         zone_retry = Some(k + 1);
                         m
@@ -350,17 +361,23 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
                         zone_mark(&fields, &edges)
                     }
+                },
+                Some(Err(e)) => {
+                    ctx.log(format!("accuracy: the adjoint failed ({e}); level {} refines the pressurised zone", k + 1));
+                    zone_mark(&fields, &edges)
                 }
-            } else {
-                zone_mark(&fields, &edges)
+                None => zone_mark(&fields, &edges),
             })
         } else {
             None
         };
+        drop(adjoint);
+        // A level's time includes its adjoint and the marking of the next one.
+        levels.last_mut().expect("the level just pushed").seconds = t0.elapsed().as_secs_f64();
         let condensation_s = solver.condensation_s;
         drop(fields);
         drop(solver);
-        let here = Solved { setup, sol, hc: st.hc, condensation_s };
+        let here = Solved { setup, sol, hc: st.hc, condensation_s, exponents };
         if reached {
             ctx.log(format!("accuracy: target {target} reached at level {k}"));
             return finish(ctx, scene, &here, target, &levels, None);
@@ -433,7 +450,7 @@ fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Le
         if ctx.rank == 0 {
             add_accuracy_to_summary(ctx, dir, target, levels, shortfall.as_deref())?;
         }
-        Ok(())
+        super::sensitivity::add_to_summary(ctx, dir, done.exponents.as_ref())
     })?;
     if let Some(why) = shortfall {
         ctx.log(&why);

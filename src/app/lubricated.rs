@@ -156,11 +156,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let setup = Setup::new(ctx, scene)?;
     crate::interrupt::check("the mesh")?;
     let report = effects_report(scene, setup.half);
-    ctx.log(format!(
-        "simulated: {}",
-        report["simulated"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")
-    ));
-    ctx.log(format!("skipped: {}", report["skipped"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
+    for part in ["simulated", "skipped"] {
+        ctx.log(format!("{part}: {}", report[part].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
+    }
     let solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
     if scene.is_sweep() {
         return super::sweep::run(ctx, scene, &setup, &solver);
@@ -173,7 +171,11 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     crate::interrupt::check("the Newton solve")?;
     // The friction pass and every output file go to a staging folder, moved into the
     // output folder only when complete and not interrupted.
-    ctx.write_results(|dir| post_point(ctx, scene, &setup, &sol, solver.condensation_s, dir)).map(|_| ())
+    let exponents = super::sensitivity::of_state(ctx, scene, &solver, &setup.mesh, &setup.layout, &sol.x);
+    ctx.write_results(|dir| {
+        post_point(ctx, scene, &setup, &sol, solver.condensation_s, dir)?;
+        super::sensitivity::add_to_summary(ctx, dir, exponents.as_ref())
+    })
 }
 
 /// The friction setup of the scene, or None when `effects.friction = "none"`.

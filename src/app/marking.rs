@@ -8,7 +8,7 @@
 use super::adapt::MIN_ADAPTIVE_SIZE;
 use super::Context;
 use crate::case::Scene;
-use crate::ehl::driver::{self, EhlSolver};
+use crate::ehl::driver::{self, Adjoint};
 use crate::ehl::post::{FieldsOnFace, FilmStats};
 use crate::error::Error;
 use crate::mesh::size_field::SizeField;
@@ -127,12 +127,10 @@ pub(super) fn zone_mark(fields: &FieldsOnFace, edges: &[f64]) -> Vec<bool> {
 /// relative to that film, summed over the films; Doerfler marking at `theta`. The films
 /// are hc, hm and, with friction, the mean film over the Hertz circle (the shear stress
 /// is made there, and varies like 1/h).
-#[allow(clippy::too_many_arguments)]
 pub(super) fn goal_mark(
     ctx: &Context,
     scene: &Scene,
-    solver: &EhlSolver,
-    x: &[f64],
+    adjoint: &Adjoint,
     fields: &FieldsOnFace,
     st: &FilmStats,
     edges: &[f64],
@@ -140,19 +138,15 @@ pub(super) fn goal_mark(
 ) -> Result<Vec<bool>, Error> {
     let t0 = Instant::now();
     let mesh = fields.mesh;
-    let at = |p: [f64; 2]| -> Result<Vec<(u32, f64)>, Error> {
-        let (t, b) = fields
-            .locate(p[0], p[1])
-            .ok_or_else(|| Error::numerical(format!("accuracy: ({}, {}) is not on the contact face", p[0], p[1])))?;
-        let phi = crate::fem::p2tri::p2_tri_basis_bary(b);
-        Ok(mesh.contact_tris[t].iter().zip(phi).map(|(&n, w)| (n, w)).collect())
-    };
-    let mut films = vec![(at([0.0, 0.0])?, st.hc), (at(st.hm_at)?, st.hm)];
+    let mut films = vec![(film_weights(fields, [0.0, 0.0])?, st.hc), (film_weights(fields, st.hm_at)?, st.hm)];
     if scene.effects.friction != crate::case::FrictionModel::Off {
         films.push(mean_film_in_hertz_circle(fields));
     }
-    let (weights, values): (Vec<Vec<(u32, f64)>>, Vec<f64>) = films.into_iter().unzip();
-    let z = solver.film_adjoints(ctx, scene, x, &weights)?;
+    let mut z = Vec::with_capacity(films.len());
+    for (w, _) in &films {
+        z.push(adjoint.pressure_part(&adjoint.film(ctx, w)?));
+    }
+    let values: Vec<f64> = films.iter().map(|f| f.1).collect();
     let rho = indicators(scene, fields);
     let surplus = |z: &[f64], tri: &[u32; 6]| {
         (0..3).map(|e| (z[tri[3 + e] as usize] - 0.5 * (z[tri[e] as usize] + z[tri[(e + 1) % 3] as usize])).abs()).fold(0.0, f64::max)
@@ -191,4 +185,9 @@ fn mean_film_in_hertz_circle(fields: &FieldsOnFace) -> (Vec<(u32, f64)>, f64) {
     let weights: Vec<(u32, f64)> = w.into_iter().map(|(n, v)| (n, v / total)).collect();
     let mean = weights.iter().map(|&(n, v)| v * fields.h_node(n)).sum();
     (weights, mean)
+}
+
+/// The P2 interpolation weights of the film at `p` (units of a) on the contact face.
+pub(super) fn film_weights(fields: &FieldsOnFace, p: [f64; 2]) -> Result<Vec<(u32, f64)>, Error> {
+    fields.weights_at(p[0], p[1]).ok_or_else(|| Error::numerical(format!("accuracy: ({}, {}) is not on the contact face", p[0], p[1])))
 }

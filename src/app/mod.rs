@@ -7,6 +7,7 @@ pub mod lubricated;
 mod marking;
 pub mod plots;
 pub mod restart;
+mod sensitivity;
 pub mod study;
 pub mod subsurface;
 pub mod sweep;

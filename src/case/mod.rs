@@ -358,6 +358,14 @@ impl Scene {
                 .into());
             }
         }
+        if self.output.speed_exponents
+            && (e.lubrication != LubricationModel::Reynolds || e.elasticity == ElasticityModel::Rigid || self.sweep.is_some())
+        {
+            return Err(SceneErrorKind::Conflict(
+                "output.speed_exponents = true needs a lubricated elastic single-point scene (effects.lubrication = \"reynolds\", effects.elasticity = \"elastic\", no [sweep]); set output.speed_exponents = false".into(),
+            )
+            .into());
+        }
         if self.output.subsurface && e.elasticity == ElasticityModel::Rigid {
             return Err(SceneErrorKind::Conflict(
                 "output.subsurface = true needs the elastic solid, but effects.elasticity = \"rigid\" has no 3D mesh (set effects.elasticity = \"elastic\" or output.subsurface = false)".into(),

@@ -305,7 +305,10 @@ fn unknown_key_with_suggestion() {
     assert_eq!(e, "unknown key 'geometry.load' (did you mean 'operating.load'?)");
     // Nothing close: list the known keys.
     let e = err(&paper_with("png = false", "png = false\ncolour = true"));
-    assert_eq!(e, "unknown key 'output.colour' (known keys here: dir, vtu, png, shear_profile_z, subsurface, subsurface_recovery)");
+    assert_eq!(
+        e,
+        "unknown key 'output.colour' (known keys here: dir, vtu, png, shear_profile_z, subsurface, subsurface_recovery, speed_exponents)"
+    );
 }
 
 #[test]
@@ -542,6 +545,11 @@ fn subsurface_keys_are_checked_together() {
     // Rigid solids have no 3D mesh.
     let e = err(&paper_with("[output]", "[output]\nsubsurface = true").replace("elasticity = \"elastic\"", "elasticity = \"rigid\""));
     assert!(e.contains("output.subsurface") && e.contains("rigid"), "{e}");
+    // The speed exponents need the elastic film and one operating point.
+    let e = err(&paper_with("[output]", "[output]\nspeed_exponents = true").replace("elasticity = \"elastic\"", "elasticity = \"rigid\""));
+    assert!(e.contains("output.speed_exponents") && e.contains("single-point"), "{e}");
+    let e = err(&dry.replace("[output]", "[output]\nspeed_exponents = true"));
+    assert!(e.contains("output.speed_exponents"), "{e}");
     // The defaults: off, nothing asked.
     let s = parse_scene(PAPER_SPIN, "t").unwrap();
     assert!(!s.output.subsurface);

@@ -65,6 +65,14 @@ impl<'a> FieldsOnFace<'a> {
         Some((crate::fem::p2_tri_eval(&p, b), crate::fem::p2_tri_eval(&h, b)))
     }
 
+    /// The P2 interpolation at (x, z) as nodal weights (summing to 1): a point value of any
+    /// nodal field as sum_n w_n f_n.
+    pub fn weights_at(&self, x: f64, z: f64) -> Option<Vec<(u32, f64)>> {
+        let (t, b) = self.locate(x, z)?;
+        let phi = crate::fem::p2tri::p2_tri_basis_bary(b);
+        Some(self.mesh.contact_tris[t].iter().zip(phi).map(|(&n, w)| (n, w)).collect())
+    }
+
     /// Central film, minimum film (searched on a lattice of 15 points per triangle),
     /// maximum pressure, and the load integral.
     pub fn stats(&self) -> FilmStats {

@@ -318,6 +318,10 @@ pub struct OutputSettings {
     pub subsurface: bool,
     /// "spr" | "average"; default "spr".
     pub subsurface_recovery: StressRecovery,
+    /// The films' exponents in eta_R Ue (d ln hc / d ln(eta_R Ue), the same for hm) at the
+    /// converged state, from their adjoints (`speed_exponents` in summary.json); default
+    /// false.
+    pub speed_exponents: bool,
 }
 
 impl Default for OutputSettings {
@@ -330,6 +334,7 @@ impl Default for OutputSettings {
             shear_profile_z: 0.0,
             subsurface: false,
             subsurface_recovery: StressRecovery::Spr,
+            speed_exponents: false,
         }
     }
 }
@@ -359,5 +364,12 @@ pub const OUTPUT_FIELDS: &[Field] = &[
         "",
         Kind::Choice(StressRecovery::NAMES),
         Presence::Default("\"spr\"")
+    ),
+    f!(
+        "speed_exponents",
+        "the films' exponents in eta_R Ue, d ln hc / d ln(eta_R Ue) and d ln hm / d ln(eta_R Ue), from their adjoints (one extra LU); lubricated elastic single-point scenes",
+        "",
+        Kind::Bool,
+        Presence::Default("false")
     ),
 ];

@@ -17,6 +17,7 @@ mod problem;
 mod start;
 
 use crate::error::Error;
+pub use adjoint::{film_derivative, Adjoint};
 pub use diagnostics::{check_jacobian, POLE_COLLAPSE};
 use policy::Attempt;
 pub use policy::{set_newton_defaults, set_newton_linear_solver, Coupling, CONDENSED_PREFIX};

@@ -1,0 +1,71 @@
+//! The films' exponents in eta_R Ue (`output.speed_exponents`): d ln hc / d ln(eta_R Ue)
+//! and d ln hm / d ln(eta_R Ue) of the converged discrete solution, from the adjoints of hc
+//! and hm and the residual's derivative in lambda_bar (`ehl::driver::adjoint`).
+//!
+//! They are what a tribologist reads off a film formula (Hamrock and Dowson: 0.67 and
+//! 0.68) for this operating point, at the cost of one LU and two transposed solves instead
+//! of two more runs; a finite difference of two runs at eta_R Ue (1 +- eps) on the same
+//! mesh checks them (`tests/accuracy.rs`).
+use super::marking::film_weights;
+use super::Context;
+use crate::ehl::driver::{film_derivative, Adjoint};
+use crate::ehl::post::{FieldsOnFace, FilmStats};
+use crate::error::Error;
+use serde_json::json;
+use std::path::Path;
+
+/// The exponents of hc and hm in eta_R Ue at the adjoint's state. Collective.
+pub(super) fn speed_exponents(ctx: &Context, adjoint: &mut Adjoint, fields: &FieldsOnFace, st: &FilmStats) -> Result<[f64; 2], Error> {
+    let df = adjoint.residual_speed_derivative()?;
+    let zc = adjoint.film(ctx, &film_weights(fields, [0.0, 0.0])?)?;
+    let zm = adjoint.film(ctx, &film_weights(fields, st.hm_at)?)?;
+    Ok([film_derivative(&zc, &df) / st.hc, film_derivative(&zm, &df) / st.hm])
+}
+
+/// The exponents at the converged state `x` of a solver, logged, as the summary's value
+/// (None when the scene does not ask for them). A failure is reported, not fatal: the film
+/// result stands without them. Collective.
+pub(super) fn of_state(
+    ctx: &Context,
+    scene: &crate::case::Scene,
+    solver: &crate::ehl::driver::EhlSolver,
+    mesh: &crate::mesh::Mesh,
+    layout: &crate::ehl::layout::Layout,
+    x: &[f64],
+) -> Option<serde_json::Value> {
+    if !scene.output.speed_exponents {
+        return None;
+    }
+    let fields = FieldsOnFace::new(mesh, layout, x);
+    let st = fields.stats();
+    let got =
+        crate::collective::agree(&ctx.world, solver.adjoint(ctx, scene, x).and_then(|mut a| speed_exponents(ctx, &mut a, &fields, &st)));
+    Some(report(ctx, got))
+}
+
+/// Logs the exponents (or why they are missing) and returns the summary's value.
+pub(super) fn report(ctx: &Context, got: Result<[f64; 2], Error>) -> serde_json::Value {
+    match got {
+        Ok([hc, hm]) => {
+            ctx.log(format!("speed exponents: d ln hc / d ln(eta_R Ue) = {hc:.5}, d ln hm / d ln(eta_R Ue) = {hm:.5} (adjoint)"));
+            json!({ "hc": hc, "hm": hm, "method": "adjoint of hc and hm against the residual's derivative in lambda_bar" })
+        }
+        Err(e) => {
+            ctx.log(format!("warning: the speed exponents asked for by output.speed_exponents were not computed: {e}"));
+            json!({ "failed": e.to_string() })
+        }
+    }
+}
+
+/// Adds `speed_exponents` to the summary.json in `dir` (rank 0; nothing without a value).
+pub(super) fn add_to_summary(ctx: &Context, dir: &Path, value: Option<&serde_json::Value>) -> Result<(), Error> {
+    let Some(value) = value else { return Ok(()) };
+    if ctx.rank != 0 {
+        return Ok(());
+    }
+    let path = dir.join("summary.json");
+    let text = std::fs::read_to_string(&path).map_err(Error::reading(&path))?;
+    let mut summary: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::format(format!("{}: {e}", path.display())))?;
+    summary["speed_exponents"] = value.clone();
+    ctx.write_summary_to(dir, &summary)
+}
