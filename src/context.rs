@@ -15,9 +15,6 @@ pub struct Context {
     pub out_dir: PathBuf,
     pub quiet: bool,
     pub start: Instant,
-    /// Set when a result was written without reaching its accuracy target (the reason):
-    /// the run exits 4.
-    pub shortfall: std::cell::RefCell<Option<String>>,
 }
 
 impl Context {

@@ -22,7 +22,7 @@
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
 use super::lubricated::{post_point, Setup};
 use super::marking::{goal_mark, longest_edges, next_field, within_radius, zone_mark};
-use super::Context;
+use super::{Context, Outcome};
 use crate::case::Scene;
 use crate::collective;
 use crate::ehl::driver::{EhlSolution, EhlSolver, Start};
@@ -181,7 +181,7 @@ struct Solved {
 /// Collective. When the target cannot be reached (`max_levels`, `max_unknowns`, every
 /// triangle at the smallest size) the last level's result is written with its estimated
 /// error and `ctx.shortfall` says why (exit 4).
-pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<(), Error> {
+pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<Outcome, Error> {
     let acc = scene.accuracy;
     let target = acc.target;
     let max_levels = acc.max_levels as usize;
@@ -402,7 +402,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
 /// After level `k` stopped with `e`: when the time budget was spent (and a level converged
 /// before), the last converged level's result, labelled as short of its target; any other
 /// error (a signal, a failure outside Newton) stops the run.
-fn out_of_time(ctx: &Context, scene: &Scene, prev: Option<&Solved>, k: usize, levels: &[Level], e: Error) -> Result<(), Error> {
+fn out_of_time(ctx: &Context, scene: &Scene, prev: Option<&Solved>, k: usize, levels: &[Level], e: Error) -> Result<Outcome, Error> {
     match prev {
         // (`finish` clears the spent budget before it writes.)
         Some(prev) if crate::interrupt::agreed() == crate::interrupt::DEADLINE => {
@@ -441,7 +441,7 @@ fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<[f64; 2
 
 /// Writes the result of `done` (the last level solved) with the accuracy report; with a
 /// `shortfall` the report says the target was not reached and the run exits 4.
-fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Level], shortfall: Option<String>) -> Result<(), Error> {
+fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Level], shortfall: Option<String>) -> Result<Outcome, Error> {
     // The budget bounds the refinement, not the writing of its result.
     crate::interrupt::clear_deadline();
     crate::interrupt::check("the Newton solve")?;
@@ -452,11 +452,13 @@ fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Le
         }
         super::sensitivity::add_to_summary(ctx, dir, done.exponents.as_ref())
     })?;
-    if let Some(why) = shortfall {
-        ctx.log(&why);
-        *ctx.shortfall.borrow_mut() = Some(why);
-    }
-    Ok(())
+    Ok(match shortfall {
+        Some(why) => {
+            ctx.log(&why);
+            Outcome::ShortOfTarget(why)
+        }
+        None => Outcome::Done,
+    })
 }
 
 /// Adds `accuracy` (target, estimates, levels) to the summary.json that post_point wrote.

@@ -3,7 +3,7 @@
 //! output folder. A scene with `[sweep]` solves every operating point of the sweep on the
 //! same mesh and condensed elastic block, each point from the previous converged state
 //! (see [`super::sweep`]).
-use super::{collective, Context};
+use super::{collective, Context, Outcome};
 use crate::case::{FrictionModel, Scene};
 use crate::ehl::driver::{self, EhlSolution, EhlSolver};
 use crate::ehl::{layout::Layout, post::FieldsOnFace};
@@ -139,7 +139,7 @@ pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
     })
 }
 
-pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<(), Error> {
+pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<Outcome, Error> {
     let hertz = scene.hertz();
     ctx.log(format!("Hertz: a = {:.5e} m, p_H = {:.5e} Pa; lambda_bar = {:.4e}", hertz.a, hertz.ph, driver::lambda_bar(scene)));
     if let Some(zc) = scene.spin_pole_over_a() {
@@ -161,7 +161,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     }
     let solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
     if scene.is_sweep() {
-        return super::sweep::run(ctx, scene, &setup, &solver);
+        return super::sweep::run(ctx, scene, &setup, &solver).map(|()| Outcome::Done);
     }
     let sol = match earlier {
         None => solver.solve(ctx, scene, None)?,
@@ -174,7 +174,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let exponents = super::sensitivity::of_state(ctx, scene, &solver, &setup.mesh, &setup.layout, &sol.x);
     ctx.write_results(|dir| {
         post_point(ctx, scene, &setup, &sol, solver.condensation_s, dir)?;
-        super::sensitivity::add_to_summary(ctx, dir, exponents.as_ref())
+        super::sensitivity::add_to_summary(ctx, dir, exponents.as_ref()).map(|()| Outcome::Done)
     })
 }
 

@@ -112,26 +112,24 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             return 2;
         }
     };
-    let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start, shortfall: Default::default() };
+    let ctx = Context { world, rank, size, out_dir, quiet: opts.quiet, start };
     ctx.log(format!("ehl-petsc {} on {} rank(s), {}; scene '{}'", env!("CARGO_PKG_VERSION"), size, petsc.version(), scene.name));
     let result = match opts.study_levels {
         Some(n) if scene.effects.lubrication == crate::case::LubricationModel::Reynolds => {
-            study::run(&ctx, &scene, n, opts.ladder, first_size, opts.study_sequence)
+            study::run(&ctx, &scene, n, opts.ladder, first_size, opts.study_sequence).map(|()| Outcome::Done)
         }
         Some(_) => Err(Error::invalid("--convergence-study needs a lubricated scene (effects.lubrication = \"reynolds\")")),
         None => simulate(&ctx, &scene, earlier.as_ref()),
     };
     let failed_here = result.is_err();
     let code = match collective::agree(&ctx.world, result) {
-        Ok(()) => match ctx.shortfall.borrow().as_deref() {
-            None => 0,
-            Some(why) => {
-                if rank == 0 {
-                    eprintln!("ehl-petsc: warning: {why}");
-                }
-                4
+        Ok(Outcome::Done) => 0,
+        Ok(Outcome::ShortOfTarget(why)) => {
+            if rank == 0 {
+                eprintln!("ehl-petsc: warning: {why}");
             }
-        },
+            4
+        }
         Err(e) => {
             // A failure every rank shares (Newton, an interruption) is printed once, by
             // rank 0; a rank that failed alone prints its own message.
@@ -267,13 +265,22 @@ pub fn check_mesh(scene: &Scene) -> Result<(), SceneError> {
     spec.validate().map(|_| ()).map_err(|e| SceneErrorKind::Conflict(format!("the mesh of [mesh] and [reynolds] cannot be built ({}); check mesh.cube_size, mesh.contact_size and the reynolds.x_min/x_max/z_min/z_max rectangle", e.to_string().trim_start_matches("mesh spec: "))).into())
 }
 
+/// How a run that wrote its result ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Outcome {
+    /// Everything the scene asked for.
+    Done,
+    /// A labelled result short of its accuracy target (exit 4), and why.
+    ShortOfTarget(String),
+}
+
 /// Dispatches on what the scene asks to simulate.
-fn simulate(ctx: &Context, scene: &Scene, earlier: Option<&restart::EarlierRun>) -> Result<(), Error> {
+fn simulate(ctx: &Context, scene: &Scene, earlier: Option<&restart::EarlierRun>) -> Result<Outcome, Error> {
     for w in scene.warnings().into_iter().chain(scene.plausibility().unwrap_or_default()) {
         ctx.log(format!("warning: {w}"));
     }
     match scene.effects.lubrication {
-        crate::case::LubricationModel::Dry => dry::run(ctx, scene),
+        crate::case::LubricationModel::Dry => dry::run(ctx, scene).map(|()| Outcome::Done),
         crate::case::LubricationModel::Reynolds => lubricated::run(ctx, scene, earlier),
     }
 }
