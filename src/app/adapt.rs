@@ -294,7 +294,25 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         };
         let fields = FieldsOnFace::new(&setup.mesh, &setup.layout, &sol.x);
         let st = fields.stats();
-        if ![st.hc, st.hm, st.pmax].iter().all(|v| v.is_finite()) || st.hm <= 0.0 {
+        let unphysical = ![st.hc, st.hm, st.pmax].iter().all(|v| v.is_finite()) || st.hm <= 0.0;
+        // A first level whose film dips below zero between its nodes (the P2 film under a
+        // spin pole or a side lobe narrower than its elements: cases/hard/spin-0.33deg at
+        // 0.25 a) is refined and solved again like one that does not converge.
+        if unphysical && previous.is_none() && earlier.is_none() && first_retries < FIRST_LEVEL_RETRIES {
+            ctx.log(format!(
+                "accuracy: the first level converged to a film that is not positive everywhere (hm = {:.3e} at ({:.3}a, {:.3}a)); again with the contact triangles within r <= {FIRST_RETRY_RADIUS} a halved",
+                st.hm, st.hm_at[0], st.hm_at[1]
+            ));
+            field = Some(Arc::new(next_field(
+                &setup.mesh,
+                &longest_edges(&setup.mesh),
+                &within_radius(&setup.mesh, FIRST_RETRY_RADIUS),
+                growth,
+            )));
+            first_retries += 1;
+            continue;
+        }
+        if unphysical {
             return Err(Error::numerical(format!(
                 "accuracy: level {k} converged to an unphysical state (hc {}, hm {}); no result written",
                 st.hc, st.hm
