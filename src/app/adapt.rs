@@ -180,7 +180,7 @@ struct Solved {
 /// Runs the adaptive loop of a lubricated single-point scene with `accuracy.target > 0`.
 /// Collective. When the target cannot be reached (`max_levels`, `max_unknowns`, every
 /// triangle at the smallest size) the last level's result is written with its estimated
-/// error and `ctx.shortfall` says why (exit 4).
+/// error and the returned [`Outcome::ShortOfTarget`] says why (exit 4).
 pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<Outcome, Error> {
     let acc = scene.accuracy;
     let target = acc.target;
