@@ -67,6 +67,19 @@ impl Context {
         collective::agree(&self.world, made)
     }
 
+    /// Reads the summary.json that a post-processing step wrote into `dir`, lets `change`
+    /// add to it, and writes it again (rank 0; the other ranks do nothing).
+    pub fn amend_summary(&self, dir: &std::path::Path, change: impl FnOnce(&mut serde_json::Value)) -> Result<(), Error> {
+        if self.rank != 0 {
+            return Ok(());
+        }
+        let path = dir.join("summary.json");
+        let text = std::fs::read_to_string(&path).map_err(Error::reading(&path))?;
+        let mut summary: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::format(format!("{}: {e}", path.display())))?;
+        change(&mut summary);
+        self.write_summary_to(dir, &summary)
+    }
+
     /// Writes summary.json into `dir` (atomically; see [`Context::write_summary`]).
     pub fn write_summary_to(&self, dir: &std::path::Path, summary: &serde_json::Value) -> Result<(), Error> {
         let path = dir.join("summary.json");

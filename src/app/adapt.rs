@@ -166,6 +166,13 @@ const FIRST_LEVEL_RETRIES: usize = 2;
 /// outlet constriction and the side lobes (r up to about 1.1 a).
 const FIRST_RETRY_RADIUS: f64 = 1.3;
 
+/// The size field of a first level solved again: `mesh`'s contact triangles within
+/// r <= [`FIRST_RETRY_RADIUS`] halved, logged with `why` the first try failed.
+fn first_level_again(ctx: &Context, mesh: &crate::mesh::Mesh, growth: f64, why: &str) -> Arc<SizeField> {
+    ctx.log(format!("accuracy: the first level {why}; again with the contact triangles within r <= {FIRST_RETRY_RADIUS} a halved"));
+    Arc::new(next_field(mesh, &longest_edges(mesh), &within_radius(mesh, FIRST_RETRY_RADIUS), growth))
+}
+
 /// A solved level kept for the next one: its setup, solution, dimensionless central film
 /// and condensation time.
 struct Solved {
@@ -278,14 +285,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                             matches!(e.root(), Error::NotConverged(_)) && !e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE),
                         ) =>
                 {
-                    let edges = longest_edges(&setup.mesh);
-                    let marked = within_radius(&setup.mesh, FIRST_RETRY_RADIUS);
                     let why = e.to_string();
-                    ctx.log(format!(
-                        "accuracy: the first level did not converge on its mesh ({}); again with the contact triangles within r <= {FIRST_RETRY_RADIUS} a halved",
-                        why.split("; path:").next().unwrap_or(&why)
-                    ));
-                    field = Some(Arc::new(next_field(&setup.mesh, &edges, &marked, growth)));
+                    let why = format!("did not converge on its mesh ({})", why.split("; path:").next().unwrap_or(&why));
+                    field = Some(first_level_again(ctx, &setup.mesh, growth, &why));
                     first_retries += 1;
                     continue;
                 }
@@ -299,16 +301,11 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // spin pole or a side lobe narrower than its elements: cases/hard/spin-0.33deg at
         // 0.25 a) is refined and solved again like one that does not converge.
         if unphysical && previous.is_none() && earlier.is_none() && first_retries < FIRST_LEVEL_RETRIES {
-            ctx.log(format!(
-                "accuracy: the first level converged to a film that is not positive everywhere (hm = {:.3e} at ({:.3}a, {:.3}a)); again with the contact triangles within r <= {FIRST_RETRY_RADIUS} a halved",
+            let why = format!(
+                "converged to a film that is not positive everywhere (hm = {:.3e} at ({:.3}a, {:.3}a))",
                 st.hm, st.hm_at[0], st.hm_at[1]
-            ));
-            field = Some(Arc::new(next_field(
-                &setup.mesh,
-                &longest_edges(&setup.mesh),
-                &within_radius(&setup.mesh, FIRST_RETRY_RADIUS),
-                growth,
-            )));
+            );
+            field = Some(first_level_again(ctx, &setup.mesh, growth, &why));
             first_retries += 1;
             continue;
         }
@@ -465,10 +462,12 @@ fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Le
     crate::interrupt::check("the Newton solve")?;
     ctx.write_results(|dir| {
         post_point(ctx, scene, &done.setup, &done.sol, done.condensation_s, dir)?;
-        if ctx.rank == 0 {
-            add_accuracy_to_summary(ctx, dir, target, levels, shortfall.as_deref())?;
-        }
-        super::sensitivity::add_to_summary(ctx, dir, done.exponents.as_ref())
+        ctx.amend_summary(dir, |summary| {
+            summary["accuracy"] = accuracy_report(target, levels, shortfall.as_deref());
+            if let Some(e) = &done.exponents {
+                summary["speed_exponents"] = e.clone();
+            }
+        })
     })?;
     Ok(match shortfall {
         Some(why) => {
@@ -479,19 +478,10 @@ fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Le
     })
 }
 
-/// Adds `accuracy` (target, estimates, levels) to the summary.json that post_point wrote.
-fn add_accuracy_to_summary(
-    ctx: &Context,
-    dir: &std::path::Path,
-    target: f64,
-    levels: &[Level],
-    shortfall: Option<&str>,
-) -> Result<(), Error> {
-    let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path).map_err(Error::reading(&path))?;
-    let mut summary: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::format(format!("{}: {e}", path.display())))?;
+/// The `accuracy` object of summary.json: target, estimates, levels.
+fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> serde_json::Value {
     let last = levels.last().expect("a level");
-    summary["accuracy"] = json!({
+    let mut report = json!({
         "target": target,
         "reached": shortfall.is_none(),
         "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it), and at least 1/8 of the change before the last from the second change on",
@@ -514,12 +504,12 @@ fn add_accuracy_to_summary(
         }).collect::<Vec<_>>(),
     });
     if let Some(e) = last.est {
-        summary["accuracy"]["estimated_error"] = e.json();
+        report["estimated_error"] = e.json();
     }
     if let Some(why) = shortfall {
-        summary["accuracy"]["not_reached_because"] = json!(why);
+        report["not_reached_because"] = json!(why);
     }
-    ctx.write_summary_to(dir, &summary)
+    report
 }
 
 #[cfg(test)]

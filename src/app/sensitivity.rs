@@ -59,13 +59,8 @@ pub(super) fn report(ctx: &Context, got: Result<[f64; 2], Error>) -> serde_json:
 
 /// Adds `speed_exponents` to the summary.json in `dir` (rank 0; nothing without a value).
 pub(super) fn add_to_summary(ctx: &Context, dir: &Path, value: Option<&serde_json::Value>) -> Result<(), Error> {
-    let Some(value) = value else { return Ok(()) };
-    if ctx.rank != 0 {
-        return Ok(());
+    match value {
+        Some(v) => ctx.amend_summary(dir, |summary| summary["speed_exponents"] = v.clone()),
+        None => Ok(()),
     }
-    let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path).map_err(Error::reading(&path))?;
-    let mut summary: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::format(format!("{}: {e}", path.display())))?;
-    summary["speed_exponents"] = value.clone();
-    ctx.write_summary_to(dir, &summary)
 }
