@@ -3,8 +3,8 @@
 //! 1. Solve on the scene's mesh (level 0).
 //! 2. Mark the fewest contact triangles that carry the fraction `accuracy.marking` of the
 //!    goal-oriented indicator: the mass-flux residual ([`crate::reynolds::estimate`])
-//!    weighted by the adjoints of hc, hm and, with friction, the mean film over the Hertz
-//!    circle (how much a flux error in each triangle moves them); with `marking` 0, every
+//!    weighted by the adjoints of hc, hm and, with friction, fx and fz (how much a flux
+//!    error in each triangle moves them); with `marking` 0, every
 //!    triangle of the pressurised zone (a nodal pressure above 0.01 p_H). Halve their size,
 //!    keep the others' (a graded size field on the face, [`crate::mesh::size_field`]), and
 //!    mesh the solid anew under it (conforming bisection).
@@ -367,7 +367,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             Some(match adjoint.as_ref().filter(|_| goal) {
                 // A failed adjoint costs this level's goal-oriented marking, not the run (an
                 // interruption is acted on at the check after the marking).
-                Some(Ok(a)) => match collective::agree(&ctx.world, goal_mark(ctx, scene, a, &fields, &st, &edges, acc.marking)) {
+                Some(Ok(a)) => match collective::agree(
+                    &ctx.world,
+                    goal_mark(ctx, scene, a, &fields, &st, levels.last().and_then(|l| l.friction), &edges, acc.marking),
+                ) {
                     Ok(m) => {
                         zone_retry = Some(k + 1);
                         m

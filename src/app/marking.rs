@@ -2,7 +2,7 @@
 //! contact triangles, and the size field of the next level built from it.
 //!
 //! - Goal-oriented marking (`accuracy.marking` = theta > 0): the mass-flux residual of
-//!   each triangle weighted by how much it moves the target films (their adjoints), the
+//!   each triangle weighted by how much it moves the target values (their adjoints), the
 //!   fewest triangles carrying the fraction theta of the total (Doerfler).
 //! - Zone marking (`accuracy.marking = 0`): every triangle of the pressurised zone.
 use super::adapt::MIN_ADAPTIVE_SIZE;
@@ -122,31 +122,42 @@ pub(super) fn zone_mark(fields: &FieldsOnFace, edges: &[f64]) -> Vec<bool> {
 }
 
 /// Goal-oriented marking: each triangle's mass-flux indicator weighted by how much a flux
-/// error there moves each target film (its adjoint's hierarchical P2 surplus over the
+/// error there moves each target value (its adjoint's hierarchical P2 surplus over the
 /// triangle's edges: the part of the adjoint the triangle's P1 interpolant misses),
-/// relative to that film, summed over the films; Doerfler marking at `theta`. The films
-/// are hc, hm and, with friction, the mean film over the Hertz circle (the shear stress
-/// is made there, and varies like 1/h).
+/// relative to that value, summed over the values; Doerfler marking at `theta`. The values
+/// are hc, hm and, with friction (`friction`: this level's fx, fz), fx and fz, each relative
+/// to the friction coefficient's magnitude as in the estimate (fz vanishes without spin).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn goal_mark(
     ctx: &Context,
     scene: &Scene,
     adjoint: &Adjoint,
     fields: &FieldsOnFace,
     st: &FilmStats,
+    friction: Option<[f64; 2]>,
     edges: &[f64],
     theta: f64,
 ) -> Result<Vec<bool>, Error> {
     let t0 = Instant::now();
     let mesh = fields.mesh;
-    let mut films = vec![(film_weights(fields, [0.0, 0.0])?, st.hc), (film_weights(fields, st.hm_at)?, st.hm)];
-    if scene.effects.friction != crate::case::FrictionModel::Off {
-        films.push(mean_film_in_hertz_circle(fields));
+    // (name, the adjoint's pressure part, the value's scale)
+    let mut goals: Vec<(&str, Vec<f64>, f64)> = Vec::new();
+    for (name, at, value) in [("hc", [0.0, 0.0], st.hc), ("hm", st.hm_at, st.hm)] {
+        goals.push((name, adjoint.pressure_part(&adjoint.film(ctx, &film_weights(fields, at)?)?), value));
     }
-    let mut z = Vec::with_capacity(films.len());
-    for (w, _) in &films {
-        z.push(adjoint.pressure_part(&adjoint.film(ctx, w)?));
+    if let Some(f) = friction {
+        let visc = scene.viscosity_law().expect("lubricated scene");
+        let eta = move |p: f64| visc.viscosity_and_derivative(p).0;
+        let setup = super::lubricated::friction_setup(scene, &eta, mesh.spec.contact).expect("a scene with friction");
+        let grad = crate::friction::pass::friction_gradient(fields, &setup)?;
+        let magnitude = f[0].hypot(f[1]);
+        // On a half domain fz vanishes by symmetry, and so does its gradient.
+        for (name, c) in [("fx", 0), ("fz", 1)].into_iter().take(if fields.half() { 1 } else { 2 }) {
+            let dh: Vec<(u32, f64)> = grad.nodes.iter().map(|(n, g)| (*n, g[2 * c + 1])).collect();
+            let dp: Vec<(u32, f64)> = grad.nodes.iter().map(|(n, g)| (*n, g[2 * c])).collect();
+            goals.push((name, adjoint.pressure_part(&adjoint.functional(ctx, &dh, &dp)?), magnitude));
+        }
     }
-    let values: Vec<f64> = films.iter().map(|f| f.1).collect();
     let rho = indicators(scene, fields);
     let surplus = |z: &[f64], tri: &[u32; 6]| {
         (0..3).map(|e| (z[tri[3 + e] as usize] - 0.5 * (z[tri[e] as usize] + z[tri[(e + 1) % 3] as usize])).abs()).fold(0.0, f64::max)
@@ -155,36 +166,17 @@ pub(super) fn goal_mark(
         .contact_tris
         .iter()
         .enumerate()
-        .map(|(t, tri)| z.iter().zip(&values).map(|(z, v)| rho[t] * surplus(z, tri) / v.abs()).sum())
+        .map(|(t, tri)| goals.iter().map(|(_, z, v)| rho[t] * surplus(z, tri) / v.abs()).sum())
         .collect();
     let marked = dorfler_mark(&eta, &eligible(edges), theta);
     ctx.log(format!(
-        "accuracy: goal-oriented marking ({} films): {} of {} contact triangles marked (fraction {theta} of the weighted indicator), {:.1} s",
-        values.len(),
+        "accuracy: goal-oriented marking ({}): {} of {} contact triangles marked (fraction {theta} of the weighted indicator), {:.1} s",
+        goals.iter().map(|g| g.0).collect::<Vec<_>>().join(", "),
         marked.iter().filter(|&&m| m).count(),
         marked.len(),
         t0.elapsed().as_secs_f64()
     ));
     Ok(marked)
-}
-
-/// The mean film over the Hertz circle as nodal weights (each contact triangle whose
-/// centroid lies inside, with its P2 load weights), and its value.
-fn mean_film_in_hertz_circle(fields: &FieldsOnFace) -> (Vec<(u32, f64)>, f64) {
-    let mesh = fields.mesh;
-    // Ordered, so that every rank sums the same way and marks the same triangles.
-    let mut w: BTreeMap<u32, f64> = BTreeMap::new();
-    let inside = within_radius(mesh, 1.0);
-    for (k, tri) in mesh.contact_tris.iter().enumerate().filter(|&(k, _)| inside[k]) {
-        let lw = crate::fem::p2tri::p2_tri_weights(crate::fem::p2tri::tri_area(&mesh.contact_tri_xz(k)));
-        for (i, &n) in tri.iter().enumerate() {
-            *w.entry(n).or_insert(0.0) += lw[i];
-        }
-    }
-    let total: f64 = w.values().sum();
-    let weights: Vec<(u32, f64)> = w.into_iter().map(|(n, v)| (n, v / total)).collect();
-    let mean = weights.iter().map(|&(n, v)| v * fields.h_node(n)).sum();
-    (weights, mean)
 }
 
 /// The P2 interpolation weights of the film at `p` (units of a) on the contact face.

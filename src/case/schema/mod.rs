@@ -223,7 +223,7 @@ pub struct Accuracy {
     /// Most refinement levels after the first solve; default 8.
     pub max_levels: u32,
     /// Fraction theta of the goal-oriented indicator (the mass-flux residual weighted by
-    /// the adjoints of hc, hm and, with friction, the mean film) that the marked elements
+    /// the adjoints of hc, hm and, with friction, fx and fz) that the marked elements
     /// carry (Doerfler marking); default 0.9. 0: every level refines the whole pressurised
     /// zone instead.
     pub marking: f64,
@@ -311,7 +311,7 @@ pub const ACCURACY_FIELDS: &[Field] = &[
     ),
     f!(
         "marking",
-        "fraction of the goal-oriented error indicator (mass-flux residual weighted by the adjoints of hc, hm and, with friction, the mean film) carried by the elements each level refines (Doerfler marking); 0: the whole pressurised zone at every level",
+        "fraction of the goal-oriented error indicator (mass-flux residual weighted by the adjoints of hc, hm and, with friction, fx and fz) carried by the elements each level refines (Doerfler marking); 0: the whole pressurised zone at every level",
         "",
         Kind::Number(Range::Closed(0.0, 1.0)),
         Presence::Default("0.9"),

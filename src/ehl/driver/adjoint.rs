@@ -84,12 +84,28 @@ impl Adjoint<'_> {
     /// The adjoint z of the film value with nodal weights `weights` (summing to 1), whole,
     /// on every rank (monolithic layout).
     pub fn film(&self, ctx: &Context, weights: &[(u32, f64)]) -> Result<Vec<f64>, Error> {
+        self.functional(ctx, weights, &[])
+    }
+
+    /// The adjoint z of a value J with dJ/dH_n = `dh` and dJ/dP_n = `dp` (nodal film and
+    /// pressure; nodes without a pressure unknown are skipped), whole, on every rank.
+    /// Through H_n = H0 + (X^2 + Z^2)/2 - U_y: dJ/dU_y of node n is -dJ/dH_n, and dJ/dH0
+    /// their sum.
+    pub fn functional(&self, ctx: &Context, dh: &[(u32, f64)], dp: &[(u32, f64)]) -> Result<Vec<f64>, Error> {
         let comm = petsc::comm_world();
         let (b, z) = (Vector::new(comm, self.local)?, Vector::new(comm, self.local)?);
         b.set_all(0.0)?;
         if ctx.rank == 0 {
-            let rows: Vec<i32> = weights.iter().map(|&(n, _)| self.layout.u[n as usize][1]).chain([self.layout.h0]).collect();
-            let vals: Vec<f64> = weights.iter().map(|&(_, w)| -w).chain([1.0]).collect();
+            let h0: f64 = dh.iter().map(|&(_, w)| w).sum();
+            let rows: Vec<i32> = dh
+                .iter()
+                .map(|&(n, _)| self.layout.u[n as usize][1])
+                .chain([self.layout.h0])
+                .chain(dp.iter().map(|&(n, _)| self.layout.p[n as usize]))
+                .collect();
+            let vals: Vec<f64> = dh.iter().map(|&(_, w)| -w).chain([h0]).chain(dp.iter().map(|&(_, w)| w)).collect();
+            // Added, so that a repeated row sums; the rows of nodes without a pressure
+            // unknown (negative) are dropped.
             b.set_values(&rows, &vals, true)?;
         }
         b.assemble()?;
