@@ -58,6 +58,9 @@ pub struct Level {
     /// hc, hm (m), pmax (Pa).
     pub hc: f64,
     pub hm: f64,
+    /// Where hm lies (units of a): on a full domain the minimum can move from one side
+    /// lobe to the other between levels.
+    pub hm_at: [f64; 2],
     pub pmax: f64,
     /// Friction coefficients fx, fz (scenes with friction).
     pub friction: Option<[f64; 2]>,
@@ -327,6 +330,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             seconds: t0.elapsed().as_secs_f64(),
             hc: st.hc * hs,
             hm: st.hm * hs,
+            hm_at: st.hm_at,
             pmax: st.pmax * ph,
             friction: level_friction(scene, &fields)?,
             est: None,
@@ -340,7 +344,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let level = levels.last_mut().expect("the level just pushed");
         level.est = est;
         ctx.log(format!(
-            "accuracy: level {k}: {} contact triangles (smallest {:.4} a), {} unknowns, {} Newton its, {:.1} s: hc = {:.5e} m, hm = {:.5e} m, pmax = {:.4e} Pa{}; estimated error {}",
+            "accuracy: level {k}: {} contact triangles (smallest {:.4} a), {} unknowns, {} Newton its, {:.1} s: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}; estimated error {}",
             level.contact_triangles,
             level.min_size,
             n_u + n_p + 1,
@@ -348,6 +352,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             level.seconds,
             level.hc,
             level.hm,
+            level.hm_at[0],
+            level.hm_at[1],
             level.pmax,
             level.friction.map_or(String::new(), |f| format!(", fx = {:.5e}, fz = {:.5e}", f[0], f[1])),
             level.est.map_or("- (first level)".to_string(), |e| e.describe())
@@ -493,7 +499,7 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
                 "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
                 "contact_triangles": l.contact_triangles, "smallest_size_a": l.min_size,
                 "newton_iterations": l.newton_iterations, "seconds": l.seconds,
-                "hc_m": l.hc, "hm_m": l.hm, "pmax_pa": l.pmax,
+                "hc_m": l.hc, "hm_m": l.hm, "hm_at_a": l.hm_at, "pmax_pa": l.pmax,
             });
             // The first level has no estimate: the key is left out (summary.json holds no null).
             if let Some(e) = l.est {
@@ -569,6 +575,7 @@ mod tests {
             seconds: 0.0,
             hc,
             hm: 1.0,
+            hm_at: [0.0, -0.9],
             pmax: 1.0,
             friction: f,
             est: None,
