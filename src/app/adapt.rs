@@ -456,9 +456,7 @@ fn describe(est: Option<Estimate>) -> String {
 /// The friction coefficients fx, fz of a level (every rank holds the whole iterate), or
 /// None without friction.
 fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<[f64; 2]>, Error> {
-    let visc = scene.viscosity_law().expect("lubricated scene");
-    let eta = move |p: f64| visc.viscosity_and_derivative(p).0;
-    let Some(fs) = super::lubricated::friction_setup(scene, &eta, fields.mesh.spec.contact) else { return Ok(None) };
+    let Some(fs) = super::lubricated::friction_setup(scene, fields.mesh.spec.contact) else { return Ok(None) };
     let f = crate::friction::pass::friction_pass(fields, &fs)?;
     Ok(Some([f.fx, f.fz]))
 }

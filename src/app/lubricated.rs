@@ -178,17 +178,19 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     })
 }
 
-/// The friction setup of the scene, or None when `effects.friction = "none"`.
-pub fn friction_setup<'a>(scene: &Scene, eta: &'a dyn Fn(f64) -> f64, rect: crate::mesh::Rect) -> Option<FrictionSetup<'a>> {
+/// The friction setup of the scene on the Reynolds rectangle `rect`, or None when
+/// `effects.friction = "none"`.
+pub fn friction_setup(scene: &Scene, rect: crate::mesh::Rect) -> Option<FrictionSetup> {
     let law = match scene.effects.friction {
         FrictionModel::Off => return None,
         FrictionModel::Newtonian => ShearLaw::Newtonian,
         FrictionModel::ReeEyring => ShearLaw::ReeEyring { tau0: scene.lubricant.as_ref()?.ree_eyring_stress },
     };
     let (hertz, scales) = (scene.hertz(), scene.scales());
+    let visc = scene.viscosity_law().expect("lubricated scene");
     Some(FrictionSetup {
         law,
-        eta,
+        eta: Box::new(move |p| visc.viscosity_and_derivative(p).0),
         kinematics: scene.kinematics()?,
         a: hertz.a,
         ph: hertz.ph,
@@ -245,10 +247,8 @@ pub fn post_point(
     if ctx.rank != 0 {
         return Ok(res);
     }
-    let visc = scene.viscosity_law().expect("lubricated scene");
-    let eta = move |p: f64| visc.viscosity_and_derivative(p).0;
     let rect = mesh.spec.contact;
-    let fset = friction_setup(scene, &eta, rect);
+    let fset = friction_setup(scene, rect);
     let friction = match &fset {
         Some(fs) => {
             let f = friction_pass(&fields, fs)?;

@@ -146,9 +146,7 @@ pub(super) fn goal_mark(
         goals.push((name, adjoint.pressure_part(&adjoint.film(ctx, &film_weights(fields, at)?)?), value));
     }
     if let Some(f) = friction {
-        let visc = scene.viscosity_law().expect("lubricated scene");
-        let eta = move |p: f64| visc.viscosity_and_derivative(p).0;
-        let setup = super::lubricated::friction_setup(scene, &eta, mesh.spec.contact).expect("a scene with friction");
+        let setup = super::lubricated::friction_setup(scene, mesh.spec.contact).expect("a scene with friction");
         let grad = crate::friction::pass::friction_gradient(fields, &setup)?;
         let magnitude = f[0].hypot(f[1]);
         // On a half domain fz vanishes by symmetry, and so does its gradient.

@@ -34,10 +34,10 @@ pub trait FaceSolution {
 
 /// What the pass needs besides the fields: the shear law, the viscosity law, the surface
 /// velocities and the scales that turn the dimensionless fields into SI units.
-pub struct FrictionSetup<'a> {
+pub struct FrictionSetup {
     pub law: ShearLaw,
     /// eta(p) in Pa.s for p in Pa.
-    pub eta: &'a dyn Fn(f64) -> f64,
+    pub eta: Box<dyn Fn(f64) -> f64>,
     pub kinematics: Kinematics,
     /// Hertz radius a (m), Hertz pressure p_H (Pa), film scale a^2/R (m).
     pub a: f64,
@@ -302,7 +302,7 @@ mod tests {
         let kin = crate::physics::Kinematics::new(2.0, 0.5, 60f64.to_radians(), 0.01, 0.04).unwrap();
         let s = FrictionSetup {
             law: ShearLaw::ReeEyring { tau0: 5e6 },
-            eta: &eta,
+            eta: Box::new(eta),
             kinematics: kin,
             a: 2e-4,
             ph: 1e9,
