@@ -295,7 +295,14 @@ pub fn post_point(
     let prof_x0 = profile([0.0, r.z0], [0.0, r.z1])?;
     let prof_z0 = profile([r.x0, 0.0], [r.x1, 0.0])?;
     // Wiggles of the same two lines (docs/accuracy.md, "Smooth fields").
-    let jumps = [fields.slope_jump([0.0, r.z0], [0.0, r.z1], 20001).0, fields.slope_jump([r.x0, 0.0], [r.x1, 0.0], 20001).0];
+    let (line_x0, line_z0) = (([0.0, r.z0], [0.0, r.z1]), ([r.x0, 0.0], [r.x1, 0.0]));
+    let jumps = [line_x0, line_z0].map(|(a, b)| fields.slope_jump(a, b, 20001).0);
+    let wiggles = [line_x0, line_z0].map(|(a, b)| fields.wiggle(a, b, 20001));
+    ctx.log(format!(
+        "smoothness: the largest pressure scallop is {:.4} p_H along X = 0 (at Z = {:.3} a) and {:.4} p_H along Z = 0 (at X = {:.3} a)",
+        wiggles[0].0, wiggles[0].1[1], wiggles[1].0, wiggles[1].1[0]
+    ));
+    let wiggles = wiggles.map(|w| w.0);
     res.profile_x0 = prof_x0.iter().map(|r| [r[1] / a, r[3]]).collect();
     let with_tau = friction.is_some();
     write_profiles(dir, "profile_x0.csv", &prof_x0, with_tau)?;
@@ -378,6 +385,8 @@ pub fn post_point(
             load_error_rel: load_error,
             slope_jump_x0: Some(jumps[0]),
             slope_jump_z0: Some(jumps[1]),
+            wiggle_x0: Some(wiggles[0]),
+            wiggle_z0: Some(wiggles[1]),
         },
         moes: scene.moes().map(|m| MoesSummary { m: m.m, l: m.l }),
         solver: SolverSummary {

@@ -117,7 +117,8 @@ pub fn parse_scene_with(text: &str, default_name: &str, overrides: &[String]) ->
     }
     spec::check_table(SCENE_FIELDS, &table, SCENE_FIELDS, "")?;
     let hand_mesh = table.contains_key("mesh");
-    let inlet_given = table.get("reynolds").and_then(|r| r.as_table()).is_some_and(|r| r.contains_key("x_min"));
+    let reynolds_key = |k: &str| table.get("reynolds").and_then(|r| r.as_table()).is_some_and(|r| r.contains_key(k));
+    let (inlet_given, jump_given) = (reynolds_key("x_min"), reynolds_key("gradient_jump"));
     let mut scene = Scene::deserialize(toml::Value::Table(table))
         .map_err(|e| SceneErrorKind::Syntax(format!("scene does not match the schema: {e}")))?;
     // A lubricated, elastic, single-point scene whose mesh nobody made by hand is refined
@@ -134,6 +135,9 @@ pub fn parse_scene_with(text: &str, default_name: &str, overrides: &[String]) ->
         scene.mesh.growth = schema::ADAPTIVE_GROWTH;
         if !inlet_given {
             scene.reynolds.x_min = schema::ADAPTIVE_X_MIN;
+        }
+        if !jump_given {
+            scene.reynolds.gradient_jump = schema::ADAPTIVE_GRADIENT_JUMP;
         }
     }
     // A scene that asks for the subsurface stresses without making its mesh by hand gets

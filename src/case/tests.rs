@@ -572,15 +572,20 @@ fn a_scene_without_mesh_keys_is_refined_with_the_adaptive_defaults() {
     let s = parse_scene(&minimal, "m").unwrap();
     assert_eq!(s.accuracy.target, crate::case::schema::DEFAULT_ACCURACY_TARGET);
     assert_eq!((s.mesh.growth, s.reynolds.x_min), (1.0, -4.5));
+    assert_eq!(s.reynolds.gradient_jump, crate::case::schema::ADAPTIVE_GRADIENT_JUMP);
     // Its own target: the same mesh defaults (a target given with --set behaves the same).
     let s = parse_scene_with(&minimal, "m", &["accuracy.target=0.005".into()]).unwrap();
     assert_eq!((s.accuracy.target, s.mesh.growth, s.reynolds.x_min), (0.005, 1.0, -4.5));
     // An inlet the scene gives is kept.
     let s = parse_scene_with(&minimal, "m", &["reynolds.x_min=-6".into()]).unwrap();
     assert_eq!((s.mesh.growth, s.reynolds.x_min), (1.0, -6.0));
+    // A gradient-jump factor the scene gives is kept.
+    let s = parse_scene_with(&minimal, "m", &["reynolds.gradient_jump=0".into()]).unwrap();
+    assert_eq!(s.reynolds.gradient_jump, 0.0);
     // A [mesh] key: the hand-made mesh as given, no refinement, the plain defaults.
     let s = parse_scene_with(&minimal, "m", &["mesh.contact_size=0.25".into()]).unwrap();
     assert_eq!((s.accuracy.target, s.mesh.growth, s.reynolds.x_min), (0.0, 0.5, -3.0));
+    assert_eq!(s.reynolds.gradient_jump, 0.0);
     // Target 0 on a scene without [mesh]: the plain defaults.
     let s = parse_scene_with(&minimal, "m", &["accuracy.target=0".into()]).unwrap();
     assert_eq!((s.mesh.growth, s.reynolds.x_min), (0.5, -3.0));

@@ -16,6 +16,7 @@ use crate::mesh::Mesh;
 use crate::petsc::snes::{Eval, Problem};
 use crate::petsc::{Matrix, Result, Vector};
 use crate::reynolds::element::{reynolds_element, ElementOut, Fluid};
+use crate::reynolds::jump::JumpRows;
 use crate::solid::condense::Compliance;
 
 /// Numbering of the condensed unknowns: P in `comp.cols` order, then H0; rank r owns
@@ -209,6 +210,8 @@ pub struct CondensedSystem<'a> {
     pub params: EhlParams,
     pub lubricant: Lubricant,
     elements: Vec<Element>,
+    /// Gradient-jump terms of every interior contact edge (on the pressure unknowns).
+    jumps: Vec<JumpRows>,
     /// Nodal area (a sixth of each P2 triangle at the node) of each pressure unknown.
     p_area: Vec<f64>,
     /// The block of the dense Jacobian this rank fills (default: its rows, all columns).
@@ -256,6 +259,14 @@ impl<'a> CondensedSystem<'a> {
             e.mine = e.any_dof(owned);
             elements.push(e);
         }
+        let c_j = params.stabilisation.jump;
+        let jumps = super::system::jump_terms_of(mesh, c_j, |_| true)
+            .into_iter()
+            .map(|edge| {
+                let rows = edge.nodes.iter().map(|&n| layout.p_index[n as usize]).collect();
+                JumpRows::new(edge, rows, c_j, &*params.velocity)
+            })
+            .collect();
         let p_face: Vec<usize> = comp.cols.iter().map(|&n| layout.face_index[n as usize] as usize).collect();
         let p_area = p_face.iter().map(|&f| node_area[f]).collect();
         let fill = FillBlock::new((lo..layout.ranges[rank + 1]).collect(), (0..layout.total()).collect(), comp, layout.total());
@@ -269,6 +280,7 @@ impl<'a> CondensedSystem<'a> {
             params,
             lubricant,
             elements,
+            jumps,
             p_area,
             fill,
             gap,
@@ -360,6 +372,12 @@ impl<'a> CondensedSystem<'a> {
                 cols[l].extend(dofs.iter().map(|&d| d as usize));
             }
         }
+        for jt in &self.jumps {
+            for &r in &jt.rows {
+                let Some(l) = self.own_row(r) else { continue };
+                cols[l].extend(jt.rows.iter().filter(|&&d| d >= 0).map(|&d| d as usize));
+            }
+        }
         if hi > np {
             cols[np - lo] = (0..=np).collect();
         }
@@ -395,6 +413,12 @@ impl<'a> CondensedSystem<'a> {
                 j.add_values(&[r as i32], &cols, &vals)?;
             }
         }
+        for jt in &self.jumps {
+            for (a, &r) in jt.rows.iter().enumerate().filter(|&(_, &r)| self.own_row(r).is_some()) {
+                let vals: Vec<f64> = (0..jt.rows.len()).map(|b| self.row_scale[r as usize] * jt.entry(a, b)).collect();
+                j.add_values(&[r], &jt.rows, &vals)?;
+            }
+        }
         for jn in self.owned_p() {
             let dv = penalty_slope(x[jn]);
             j.add_values(&[jn as i32], &[jn as i32], &[self.row_scale[jn] * self.params.penalty * self.p_area[jn] * dv])?;
@@ -427,6 +451,9 @@ impl EhlProblem for CondensedSystem<'_> {
         for e in &mut self.elements {
             e.vel = e.verts.map(|v| velocity(v[0], v[1]));
         }
+        for jt in &mut self.jumps {
+            jt.set_velocity(self.params.stabilisation.jump, &*velocity);
+        }
         self.params.velocity = velocity;
         true
     }
@@ -445,6 +472,11 @@ impl EhlProblem for CondensedSystem<'_> {
             let pr = e.project(&self.eval(e, &p, &he, &fluid));
             for a in 0..pr.n {
                 diag[pr.dofs[a] as usize] += pr.dp[a][a].abs();
+            }
+        }
+        for jt in &self.jumps {
+            for (a, &d) in jt.rows.iter().enumerate().filter(|(_, &d)| d >= 0) {
+                diag[d as usize] += jt.entry(a, a);
             }
         }
         for (j, d) in diag.iter().enumerate().take(self.layout.n_p) {
@@ -475,6 +507,13 @@ impl Problem for CondensedSystem<'_> {
             for a in 0..pr.n {
                 if let Some(l) = self.own_row(pr.dofs[a]) {
                     r[l] += pr.r[a];
+                }
+            }
+        }
+        for jt in &self.jumps {
+            for (a, &d) in jt.rows.iter().enumerate() {
+                if let Some(l) = self.own_row(d) {
+                    r[l] += jt.residual_row(a, x);
                 }
             }
         }
@@ -601,6 +640,16 @@ impl Problem for CondensedSystem<'_> {
                         if let Some(c) = h0_col {
                             row[c] += g;
                         }
+                    }
+                }
+            }
+        }
+        for jt in &self.jumps {
+            for (a, &d) in jt.rows.iter().enumerate() {
+                let Some(l) = fb.row_of(d) else { continue };
+                for (b, &e) in jt.rows.iter().enumerate() {
+                    if let Some(c) = fb.col_of(e) {
+                        buf[l * ncl + c] += jt.entry(a, b);
                     }
                 }
             }

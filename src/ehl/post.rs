@@ -125,13 +125,11 @@ impl<'a> FieldsOnFace<'a> {
         gx * dir[0] + gz * dir[1]
     }
 
-    /// Node-to-node wiggles of the pressure along the segment from `a` to `b`: the largest
-    /// jump of the slope dP/ds between neighbouring contact triangles, in p_H/a, and where.
-    /// The P2 pressure of a smooth field has slope jumps that vanish like h^2 |P'''|; a
-    /// wiggle is a jump of the order of the pressure variation over an element divided by
-    /// its size. The segment is sampled `n` times; at every change of triangle both
+    /// The jumps of the pressure slope dP/ds along the segment from `a` to `b` at every
+    /// change of contact triangle: (distance from `a`, signed jump, point), in units of a
+    /// and p_H/a. The segment is sampled `n` times; at every change of triangle both
     /// polynomials are differentiated at the same point (the midpoint of the two samples).
-    pub fn slope_jump(&self, a: [f64; 2], b: [f64; 2], n: usize) -> (f64, [f64; 2]) {
+    pub fn slope_jumps(&self, a: [f64; 2], b: [f64; 2], n: usize) -> Vec<(f64, f64, [f64; 2])> {
         let len = (b[0] - a[0]).hypot(b[1] - a[1]);
         let dir = [(b[0] - a[0]) / len, (b[1] - a[1]) / len];
         let point = |i: usize| {
@@ -139,7 +137,7 @@ impl<'a> FieldsOnFace<'a> {
             [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
         };
         let tri_at = |q: [f64; 2]| self.locate(q[0], q[1]).map(|(k, _)| k);
-        let (mut worst, mut at) = (0.0, [f64::NAN; 2]);
+        let mut out = Vec::new();
         let mut prev = tri_at(point(0));
         for i in 1..n {
             let (q0, q) = (point(i - 1), point(i));
@@ -154,16 +152,51 @@ impl<'a> FieldsOnFace<'a> {
                         let mirrored = self.half() && qz > 0.0;
                         self.slope_in(k, m[0], if mirrored { -m[1] } else { m[1] }, dir, mirrored)
                     };
-                    let jump = (side(k1, q[1]) - side(k0, q0[1])).abs();
-                    if jump > worst {
-                        worst = jump;
-                        at = m;
-                    }
+                    let s = (i as f64 - 0.5) / (n - 1) as f64 * len;
+                    out.push((s, side(k1, q[1]) - side(k0, q0[1]), m));
                 }
             }
             prev = here;
         }
-        (worst, at)
+        out
+    }
+
+    /// The largest jump of the slope dP/ds between neighbouring contact triangles along the
+    /// segment from `a` to `b`, in p_H/a, and where ([`Self::slope_jumps`]). The P2
+    /// pressure of a smooth field has slope jumps that vanish like h^2 |P'''|; across a
+    /// resolved outlet spike they grow as the mesh resolves its slopes.
+    pub fn slope_jump(&self, a: [f64; 2], b: [f64; 2], n: usize) -> (f64, [f64; 2]) {
+        let largest = |w: (f64, [f64; 2]), c: (f64, [f64; 2])| if c.0 > w.0 { c } else { w };
+        self.slope_jumps(a, b, n).into_iter().map(|(_, j, at)| (j.abs(), at)).fold((0.0, [f64::NAN; 2]), largest)
+    }
+
+    /// Node-to-node wiggles along the segment from `a` to `b`: the largest scallop height
+    /// |[dP/ds]| l / 8 over the changes of triangle, in p_H, and where; l is the mean
+    /// length of the segment's pieces in the two triangles. A P2 bubble of height A on a
+    /// piece of length l has end slopes of +-4 A / l, so a row of scallops of height A (the
+    /// P2 vertex mode: vertices low, mid-sides high) jumps by 8 A / l at each crossing: the
+    /// measure is A. A smooth field gives O(l^3 |P'''|), which vanishes under refinement,
+    /// also across a resolved spike; an under-resolved spike counts as the scallop it
+    /// draws.
+    pub fn wiggle(&self, a: [f64; 2], b: [f64; 2], n: usize) -> (f64, [f64; 2]) {
+        let j = self.slope_jumps(a, b, n);
+        let mut worst = (0.0, [f64::NAN; 2]);
+        for k in 0..j.len() {
+            // The first and the last piece end at the segment's ends or outside the face:
+            // there the other neighbouring piece's length is taken.
+            let left = (k > 0).then(|| j[k].0 - j[k - 1].0);
+            let right = (k + 1 < j.len()).then(|| j[k + 1].0 - j[k].0);
+            let l = match (left, right) {
+                (Some(a), Some(b)) => 0.5 * (a + b),
+                (Some(a), None) | (None, Some(a)) => a,
+                (None, None) => continue,
+            };
+            let height = j[k].1.abs() * l / 8.0;
+            if height > worst.0 {
+                worst = (height, j[k].2);
+            }
+        }
+        worst
     }
 
     /// Samples (X, Z, P, H) on the segment from `a` to `b` with `n` points.
@@ -224,5 +257,20 @@ mod tests {
         let f = FieldsOnFace::new(&m, &l, &x);
         let (j, _) = f.slope_jump([-2.4, 0.1], [2.4, 0.1], 2001);
         assert!(j > 0.04, "wiggle: {j}");
+    }
+    #[test]
+    fn the_wiggle_measure_is_the_height_of_the_vertex_mode_and_small_for_a_smooth_field() {
+        // The P2 vertex mode of height 0.01 along X: the mid-side nodes of the 0.5 a grid
+        // (at odd multiples of 0.25 a in X) 0.01 above the vertices.
+        let mode = |v: f64| if ((2.0 * v).round() - 2.0 * v).abs() > 0.1 { 0.01 } else { 0.0 };
+        let (m, l, x) = state(|x, _| 1.0 + mode(x));
+        let f = FieldsOnFace::new(&m, &l, &x);
+        let (w, _) = f.wiggle([-2.4, 0.1], [2.4, 0.1], 4001);
+        assert!(w > 0.005 && w < 0.02, "vertex mode: {w}");
+        // A smooth field of the same size on the same mesh: an order of magnitude less.
+        let (m, l, x) = state(|x, z| 1.0 + 0.05 * (x * 1.3).sin() * (z * 0.7).cos());
+        let f = FieldsOnFace::new(&m, &l, &x);
+        let (w, _) = f.wiggle([-2.4, 0.1], [2.4, 0.1], 4001);
+        assert!(w < 1e-3, "smooth: {w}");
     }
 }

@@ -6,12 +6,24 @@ use crate::mesh::{Mesh, Partition};
 use crate::solid::dofmap::owned_node_neighbours;
 use std::collections::HashMap;
 
-/// Contact-face neighbours of each contact node (nodes sharing a contact triangle).
-pub fn contact_neighbours(mesh: &Mesh) -> HashMap<u32, Vec<u32>> {
+/// Contact-face neighbours of each contact node: nodes sharing a contact triangle, and
+/// with the gradient-jump term (`jumps`) the nodes of the triangles across each edge.
+pub fn contact_neighbours(mesh: &Mesh, jumps: bool) -> HashMap<u32, Vec<u32>> {
     let mut nb: HashMap<u32, Vec<u32>> = HashMap::new();
     for tri in &mesh.contact_tris {
         for &a in tri {
             nb.entry(a).or_default().extend_from_slice(tri);
+        }
+    }
+    if jumps {
+        for (a, b, _) in crate::reynolds::jump::interior_edges(&mesh.contact_tris) {
+            let (ta, tb) = (mesh.contact_tris[a], mesh.contact_tris[b]);
+            for &n in &ta {
+                nb.entry(n).or_default().extend_from_slice(&tb);
+            }
+            for &n in &tb {
+                nb.entry(n).or_default().extend_from_slice(&ta);
+            }
         }
     }
     for v in nb.values_mut() {
@@ -22,11 +34,11 @@ pub fn contact_neighbours(mesh: &Mesh) -> HashMap<u32, Vec<u32>> {
 }
 
 /// (d_nnz, o_nnz) for the rows this rank owns.
-pub fn preallocation(mesh: &Mesh, part: &Partition, layout: &Layout, rank: usize) -> (Vec<i32>, Vec<i32>) {
+pub fn preallocation(mesh: &Mesh, part: &Partition, layout: &Layout, rank: usize, jumps: bool) -> (Vec<i32>, Vec<i32>) {
     let (lo, hi) = (layout.ranges[rank] as i32, layout.ranges[rank + 1] as i32);
     let n = (hi - lo) as usize;
     let (mut d_nnz, mut o_nnz) = (vec![0i32; n], vec![0i32; n]);
-    let contact = contact_neighbours(mesh);
+    let contact = contact_neighbours(mesh, jumps);
     let mut count = |row: i32, cols: &[i32]| {
         if row < lo || row >= hi {
             return;

@@ -12,6 +12,7 @@ use crate::pcall;
 use crate::petsc::snes::{Eval, Problem};
 use crate::petsc::{ffi, Matrix, Result, Vector};
 use crate::reynolds::element::{reynolds_element, Fluid, Stabilisation};
+use crate::reynolds::jump::{interior_edges, EdgeJump, JumpRows};
 use crate::solid::dofmap::DofMap;
 use mpi::topology::SimpleCommunicator;
 
@@ -76,6 +77,19 @@ struct ContactElement {
     area: f64,
 }
 
+/// The gradient-jump terms of the contact edges whose first triangle passes `mine`, with
+/// the coefficient `c_j` (none when it is 0).
+pub(crate) fn jump_terms_of(mesh: &Mesh, c_j: f64, mine: impl Fn(usize) -> bool) -> Vec<EdgeJump> {
+    if c_j <= 0.0 {
+        return Vec::new();
+    }
+    interior_edges(&mesh.contact_tris)
+        .into_iter()
+        .filter(|&(a, _, _)| mine(a))
+        .map(|(a, b, e)| EdgeJump::new(&mesh.contact_tris[a], &mesh.contact_tri_xz(a), &mesh.contact_tris[b], &mesh.contact_tri_xz(b), e))
+        .collect()
+}
+
 /// The EHL problem on one rank.
 pub struct EhlSystem<'a> {
     pub world: &'a SimpleCommunicator,
@@ -89,6 +103,8 @@ pub struct EhlSystem<'a> {
     /// Stiffness in the displacement-only numbering of `dofs` (for K U).
     stiffness: Matrix,
     elements: Vec<ContactElement>,
+    /// Gradient-jump terms of the interior contact edges whose first triangle is this rank's.
+    jumps: Vec<JumpRows>,
     /// Nodal penalty weights (area of the node's share of its triangles) of owned P nodes.
     penalty_nodes: Vec<(i32, u32, f64)>,
     jacobian_built: bool,
@@ -136,6 +152,14 @@ impl<'a> EhlSystem<'a> {
             let gap = tri.map(|n| Layout::gap(mesh.nodes[n as usize]));
             elements.push(ContactElement { nodes: *tri, verts, vel, gap, area: tri_area(&verts) });
         }
+        let c_j = params.stabilisation.jump;
+        let jumps = jump_terms_of(mesh, c_j, |a| part.tet_rank[mesh.contact_tri_tet[a] as usize] as usize == rank)
+            .into_iter()
+            .map(|edge| {
+                let rows = edge.nodes.iter().map(|&n| layout.p[n as usize]).collect();
+                JumpRows::new(edge, rows, c_j, &*params.velocity)
+            })
+            .collect();
         // Nodal areas for the penalty, from all contact triangles (every rank sees the mesh).
         let mut node_area = std::collections::HashMap::<u32, f64>::new();
         for tri in &mesh.contact_tris {
@@ -173,6 +197,7 @@ impl<'a> EhlSystem<'a> {
             lubricant,
             stiffness,
             elements,
+            jumps,
             penalty_nodes,
             jacobian_built: false,
             p_rows,
@@ -273,6 +298,9 @@ impl EhlProblem for EhlSystem<'_> {
         for e in &mut self.elements {
             e.vel = e.verts.map(|v| velocity(v[0], v[1]));
         }
+        for t in &mut self.jumps {
+            t.set_velocity(self.params.stabilisation.jump, &*velocity);
+        }
         self.params.velocity = velocity;
         true
     }
@@ -294,6 +322,10 @@ impl EhlProblem for EhlSystem<'_> {
             let rows: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
             let d: [f64; 6] = std::array::from_fn(|i| out.dr_dp[i][i].abs());
             diag.set_values(&rows, &d, true)?;
+        }
+        for t in &self.jumps {
+            let d: Vec<f64> = (0..t.rows.len()).map(|i| t.entry(i, i)).collect();
+            diag.set_values(&t.rows, &d, true)?;
         }
         diag.assemble()?;
         let all = diag.gather_all()?;
@@ -352,6 +384,10 @@ impl Problem for EhlSystem<'_> {
             let rows_p: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
             let r: [f64; 6] = std::array::from_fn(|i| out.r[i] * self.scale_of(rows_p[i]));
             f.set_values(&rows_p, &r, true)?;
+        }
+        for t in &self.jumps {
+            let r: Vec<f64> = (0..t.rows.len()).map(|a| t.residual_row(a, x) * self.scale_of(t.rows[a])).collect();
+            f.set_values(&t.rows, &r, true)?;
         }
         // Cavitation penalty on owned P nodes: xi * area_i * min(P_i, 0).
         for &(d, _n, area) in &self.penalty_nodes {
@@ -508,6 +544,11 @@ impl Problem for EhlSystem<'_> {
             j.add_values(&rows_p, &cols_uy, &neg)?;
             let dh0: [f64; 6] = std::array::from_fn(|i| out.dr_dh[i].iter().sum::<f64>() * sc[i]);
             j.add_values(&rows_p, &[self.layout.h0], &dh0)?;
+        }
+        for t in &self.jumps {
+            let n = t.rows.len();
+            let vals: Vec<f64> = (0..n * n).map(|k| t.entry(k / n, k % n) * self.scale_of(t.rows[k / n])).collect();
+            j.add_values(&t.rows, &t.rows, &vals)?;
         }
         for &(d, _n, area) in &self.penalty_nodes {
             // Active set includes P = 0 exactly (the kink): nodes sitting at zero pressure,

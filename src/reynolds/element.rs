@@ -72,6 +72,9 @@ pub struct Stabilisation {
     /// Peclet number (and so tau) on Habchi's convection velocity beta = (d rho_bar/dP) H v
     /// instead of v (see the module documentation).
     pub film_peclet: bool,
+    /// Factor c_J of the gradient-jump term on the interior edges ([`super::jump`]; 0: off).
+    /// The assembly adds it edge by edge; the element kernel does not see it.
+    pub jump: f64,
 }
 
 /// The terms of the SUPG strong residual r = div(rho_bar H v) - div(eps grad P) + penalty.
@@ -89,7 +92,7 @@ pub enum StrongResidual {
 impl Default for Stabilisation {
     /// SUPG on, delta = 1, full strong residual, Pe on |v|.
     fn default() -> Self {
-        Self { supg: true, delta: 1.0, id: 0.0, cd: 0.0, penalty: 0.0, residual: StrongResidual::Full, film_peclet: false }
+        Self { supg: true, delta: 1.0, id: 0.0, cd: 0.0, penalty: 0.0, residual: StrongResidual::Full, film_peclet: false, jump: 0.0 }
     }
 }
 

@@ -91,6 +91,7 @@ pub mod cavitation;
 pub mod dual;
 pub mod element;
 pub mod estimate;
+pub mod jump;
 
 #[cfg(test)]
 mod tests;

@@ -85,6 +85,11 @@ pub struct ReynoldsDomain {
     /// delta_CD = 0.1 on table2-ue2, but it also smears the side lobes of a heavily loaded
     /// contact (hm -9.5 % at 2 GPa), so the default is 0 (README "Crosswind diffusion").
     pub crosswind_diffusion: f64,
+    /// Gradient-jump factor c_J >= 0 (crate::reynolds::jump): the pressure-slope jumps
+    /// across the contact edges are penalised with gamma_E = c_J kappa |v| h_E^3. It removes
+    /// the P2 vertex mode (node-to-node wiggles in the Hertz zone) and vanishes for a smooth
+    /// pressure (consistent); 0 = off.
+    pub gradient_jump: f64,
     /// "auto" | "condensed" | "monolithic"; default "auto" (condensed up to 4,000 pressure
     /// unknowns, 8,000 in a sweep, monolithic above). The same discrete problem either way.
     pub coupling: Coupling,
@@ -94,6 +99,8 @@ pub struct ReynoldsDomain {
 pub const DEFAULT_ARTIFICIAL_DIFFUSION: f64 = 0.0;
 /// Default crosswind diffusion factor.
 pub const DEFAULT_CROSSWIND_DIFFUSION: f64 = 0.0;
+/// Default gradient-jump factor c_J.
+pub const DEFAULT_GRADIENT_JUMP: f64 = 0.0;
 
 impl Default for ReynoldsDomain {
     fn default() -> Self {
@@ -106,6 +113,7 @@ impl Default for ReynoldsDomain {
             stabilisation: Stabilisation::Supg,
             artificial_diffusion: DEFAULT_ARTIFICIAL_DIFFUSION,
             crosswind_diffusion: DEFAULT_CROSSWIND_DIFFUSION,
+            gradient_jump: DEFAULT_GRADIENT_JUMP,
             coupling: Coupling::Auto,
         }
     }
@@ -128,6 +136,8 @@ pub const REYNOLDS_FIELDS: &[Field] = &[
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0")),
     f!("crosswind_diffusion", "crosswind diffusion factor delta_CD (eps_CD = delta_CD h_e |rho' H u|, across the streamlines only; removes the crosswind stripes; 0 = off)", "",
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0")),
+    f!("gradient_jump", "gradient-jump factor c_J: the pressure-slope jumps across the contact edges are penalised with gamma = c_J kappa |v| h^3 (consistent: zero for a smooth pressure; removes the node-to-node wiggles of the P2 pressure in the Hertz zone; 0 = off)", "",
+        Kind::Number(Range::AtLeast(0.0)), Presence::Default("0; 0.01 when refined to an accuracy target without a [mesh] table")),
     f!("coupling", "how Newton couples film and solid: the elastic block condensed onto the contact face (dense LU, fast on small meshes) or one sparse monolithic matrix (MUMPS; fast on fine meshes); auto = condensed up to 4,000 pressure unknowns (a sweep: 8,000)", "",
         Kind::Choice(Coupling::NAMES), Presence::Default("\"auto\"")),
 ];

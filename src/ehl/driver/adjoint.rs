@@ -57,20 +57,11 @@ impl EhlSolver<'_> {
         let comm = petsc::comm_world();
         let eq = scene.equivalent_solid();
         let k = assembly::assemble_stiffness(comm, mesh, self.part, self.dofs, ctx.rank, eq.nu)?;
-        let (d_nnz, o_nnz) = preallocation(mesh, self.part, layout, ctx.rank);
+        let params = ehl_params(scene, eq.nu, self.half);
+        let (d_nnz, o_nnz) = preallocation(mesh, self.part, layout, ctx.rank, params.stabilisation.jump > 0.0);
         let local = layout.local(ctx.rank);
         let j = Matrix::new_aij(comm, local, &d_nnz, &o_nnz)?;
-        let mut system = EhlSystem::new(
-            &ctx.world,
-            mesh,
-            self.part,
-            self.dofs,
-            layout,
-            ctx.rank,
-            ehl_params(scene, eq.nu, self.half),
-            lubricant(scene),
-            k,
-        )?;
+        let mut system = EhlSystem::new(&ctx.world, mesh, self.part, self.dofs, layout, ctx.rank, params, lubricant(scene), k)?;
         system.jacobian(x, &j)?;
         j.assemble()?;
         petsc::ksp::set_direct_solver_defaults(ADJOINT_PREFIX)?;

@@ -333,9 +333,10 @@ fn solve_monolithic(
         }
     };
     let label = start.label();
-    let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank);
+    let params = ehl_params(scene, eq.nu, half);
+    let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank, params.stabilisation.jump > 0.0);
     let j = Matrix::new_aij(comm, layout.local(ctx.rank), &d_nnz, &o_nnz)?;
-    let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene), k)?;
+    let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, params, lubricant(scene), k)?;
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
     ctx.log(format!(

@@ -74,6 +74,7 @@ fn stabilisation(scene: &Scene, penalty: f64) -> crate::reynolds::element::Stabi
         delta: crate::ehl_options::get().supg_delta,
         id: scene.reynolds.artificial_diffusion,
         cd: scene.reynolds.crosswind_diffusion,
+        jump: scene.reynolds.gradient_jump,
         penalty,
         // Every lubricant law gets the same consistent residual; an incompressible one
         // takes its Peclet number from the elastic film response (see `supg_tau`).
