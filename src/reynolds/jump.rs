@@ -112,13 +112,6 @@ impl EdgeJump {
         let h_e = (e1[0] - e0[0]).hypot(e1[1] - e0[1]);
         EdgeJump { nodes, m, h_e, mid: [0.5 * (e0[0] + e1[0]), 0.5 * (e0[1] + e1[1])] }
     }
-
-    /// gamma_E (m p) for the nodal pressures `p` of `nodes`: the term's contribution to
-    /// the rows of `nodes`.
-    pub fn residual(&self, gamma: f64, p: &[f64]) -> Vec<f64> {
-        let d = self.nodes.len();
-        (0..d).map(|i| gamma * (0..d).map(|j| self.m[i * d + j] * p[j]).sum::<f64>()).collect()
-    }
 }
 
 /// An edge's term on the global unknowns of its nodes, as an assembly uses it.
@@ -226,10 +219,16 @@ mod tests {
         }
         // The P2 vertex mode: vertices -1, mid-sides +1 (the pressure the film cannot see).
         let p: Vec<f64> = e.nodes.iter().map(|&n| if [0, 1, 2, 3].contains(&n) { -1.0 } else { 1.0 }).collect();
-        let r = e.residual(1.0, &p);
-        let energy: f64 = r.iter().zip(&p).map(|(r, p)| r * p).sum();
-        assert!(energy > 1.0, "{energy}");
         assert!((e.h_e - 2f64.sqrt()).abs() < 1e-14 && e.mid == [0.5, 0.5]);
+        let t = JumpRows { edge: e, rows: (0..9).collect(), gamma: 1.0 };
+        let energy: f64 = (0..9).map(|a| t.residual_row(a, &p) * p[a]).sum();
+        assert!(energy > 1.0, "{energy}");
+        // A Dirichlet node (no unknown) has P = 0: its column drops out.
+        let t = JumpRows { rows: [-1].into_iter().chain(1..9).collect(), ..t };
+        let q: Vec<f64> = [0.0].into_iter().chain(p[1..].iter().copied()).collect();
+        let r0: f64 = (1..9).map(|a| t.residual_row(a, &q) * q[a]).sum();
+        let full: f64 = (0..9).map(|a| (0..9).map(|b| t.edge.m[a * 9 + b] * q[b]).sum::<f64>() * q[a]).sum();
+        assert!((r0 - full).abs() < 1e-12, "{r0} vs {full}");
     }
 
     #[test]
