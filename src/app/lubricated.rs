@@ -296,8 +296,9 @@ pub fn post_point(
     let prof_z0 = profile([r.x0, 0.0], [r.x1, 0.0])?;
     // Wiggles of the same two lines (docs/accuracy.md, "Smooth fields").
     let (line_x0, line_z0) = (([0.0, r.z0], [0.0, r.z1]), ([r.x0, 0.0], [r.x1, 0.0]));
-    let jumps = [line_x0, line_z0].map(|(a, b)| fields.slope_jump(a, b, 20001).0);
-    let wiggles = [line_x0, line_z0].map(|(a, b)| fields.wiggle(a, b, 20001));
+    let lines = [line_x0, line_z0].map(|(a, b)| fields.slope_jumps(a, b, 20001));
+    let jumps = lines.each_ref().map(|l| l.largest().0);
+    let wiggles = lines.each_ref().map(|l| l.largest_scallop());
     ctx.log(format!(
         "smoothness: the largest pressure scallop is {:.4} p_H along X = 0 (at Z = {:.3} a) and {:.4} p_H along Z = 0 (at X = {:.3} a)",
         wiggles[0].0, wiggles[0].1[1], wiggles[1].0, wiggles[1].1[0]

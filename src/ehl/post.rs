@@ -129,7 +129,7 @@ impl<'a> FieldsOnFace<'a> {
     /// change of contact triangle: (distance from `a`, signed jump, point), in units of a
     /// and p_H/a. The segment is sampled `n` times; at every change of triangle both
     /// polynomials are differentiated at the same point (the midpoint of the two samples).
-    pub fn slope_jumps(&self, a: [f64; 2], b: [f64; 2], n: usize) -> Vec<(f64, f64, [f64; 2])> {
+    pub fn slope_jumps(&self, a: [f64; 2], b: [f64; 2], n: usize) -> SlopeJumps {
         let len = (b[0] - a[0]).hypot(b[1] - a[1]);
         let dir = [(b[0] - a[0]) / len, (b[1] - a[1]) / len];
         let point = |i: usize| {
@@ -158,28 +158,44 @@ impl<'a> FieldsOnFace<'a> {
             }
             prev = here;
         }
-        out
+        SlopeJumps(out)
     }
 
-    /// The largest jump of the slope dP/ds between neighbouring contact triangles along the
-    /// segment from `a` to `b`, in p_H/a, and where ([`Self::slope_jumps`]). The P2
-    /// pressure of a smooth field has slope jumps that vanish like h^2 |P'''|; across a
-    /// resolved outlet spike they grow as the mesh resolves its slopes.
-    pub fn slope_jump(&self, a: [f64; 2], b: [f64; 2], n: usize) -> (f64, [f64; 2]) {
+    /// Samples (X, Z, P, H) on the segment from `a` to `b` with `n` points.
+    pub fn profile(&self, a: [f64; 2], b: [f64; 2], n: usize) -> Vec<[f64; 4]> {
+        (0..n)
+            .filter_map(|i| {
+                let t = i as f64 / (n - 1) as f64;
+                let (x, z) = (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]));
+                self.at(x, z).map(|(p, h)| [x, z, p, h])
+            })
+            .collect()
+    }
+}
+
+/// The jumps of the pressure slope along a segment ([`FieldsOnFace::slope_jumps`]): at
+/// every change of contact triangle, (distance from the segment's start, signed jump,
+/// point), in units of a and p_H/a.
+pub struct SlopeJumps(pub Vec<(f64, f64, [f64; 2])>);
+
+impl SlopeJumps {
+    /// The largest jump, in p_H/a, and where. The P2 pressure of a smooth field has slope
+    /// jumps that vanish like h^2 |P'''|; across a resolved outlet spike they grow as the
+    /// mesh resolves its slopes.
+    pub fn largest(&self) -> (f64, [f64; 2]) {
         let largest = |w: (f64, [f64; 2]), c: (f64, [f64; 2])| if c.0 > w.0 { c } else { w };
-        self.slope_jumps(a, b, n).into_iter().map(|(_, j, at)| (j.abs(), at)).fold((0.0, [f64::NAN; 2]), largest)
+        self.0.iter().map(|&(_, j, at)| (j.abs(), at)).fold((0.0, [f64::NAN; 2]), largest)
     }
 
-    /// Node-to-node wiggles along the segment from `a` to `b`: the largest scallop height
-    /// |[dP/ds]| l / 8 over the changes of triangle, in p_H, and where; l is the mean
-    /// length of the segment's pieces in the two triangles. A P2 bubble of height A on a
-    /// piece of length l has end slopes of +-4 A / l, so a row of scallops of height A (the
-    /// P2 vertex mode: vertices low, mid-sides high) jumps by 8 A / l at each crossing: the
-    /// measure is A. A smooth field gives O(l^3 |P'''|), which vanishes under refinement,
-    /// also across a resolved spike; an under-resolved spike counts as the scallop it
-    /// draws.
-    pub fn wiggle(&self, a: [f64; 2], b: [f64; 2], n: usize) -> (f64, [f64; 2]) {
-        let j = self.slope_jumps(a, b, n);
+    /// Node-to-node wiggles: the largest scallop height |[dP/ds]| l / 8 over the changes of
+    /// triangle, in p_H, and where; l is the mean length of the segment's pieces in the two
+    /// triangles. A P2 bubble of height A on a piece of length l has end slopes of +-4 A / l,
+    /// so a row of scallops of height A (the P2 vertex mode: vertices low, mid-sides high)
+    /// jumps by 8 A / l at each crossing: the measure is A. A smooth field gives
+    /// O(l^3 |P'''|), which vanishes under refinement, also across a resolved spike; an
+    /// under-resolved spike counts as the scallop it draws.
+    pub fn largest_scallop(&self) -> (f64, [f64; 2]) {
+        let j = &self.0;
         let mut worst = (0.0, [f64::NAN; 2]);
         for k in 0..j.len() {
             // The first and the last piece end at the segment's ends or outside the face:
@@ -197,17 +213,6 @@ impl<'a> FieldsOnFace<'a> {
             }
         }
         worst
-    }
-
-    /// Samples (X, Z, P, H) on the segment from `a` to `b` with `n` points.
-    pub fn profile(&self, a: [f64; 2], b: [f64; 2], n: usize) -> Vec<[f64; 4]> {
-        (0..n)
-            .filter_map(|i| {
-                let t = i as f64 / (n - 1) as f64;
-                let (x, z) = (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]));
-                self.at(x, z).map(|(p, h)| [x, z, p, h])
-            })
-            .collect()
     }
 }
 
@@ -244,18 +249,18 @@ mod tests {
         // off the elements next to the rectangle's edges, where P = 0 (Dirichlet).
         let (m, l, x) = state(|x, z| 1.0 - 0.1 * x * x - 0.05 * x * z + 0.02 * z * z);
         let f = FieldsOnFace::new(&m, &l, &x);
-        let (j, _) = f.slope_jump([-2.4, 0.1], [2.4, 0.1], 2001);
+        let (j, _) = f.slope_jumps([-2.4, 0.1], [2.4, 0.1], 2001).largest();
         assert!(j < 1e-9, "quadratic: {j}");
         // A kink |X| on the mesh line X = 0: the slope jumps from -1 to +1 there.
         let (m, l, x) = state(|x, _| x.abs());
         let f = FieldsOnFace::new(&m, &l, &x);
-        let (j, at) = f.slope_jump([-2.4, 0.1], [2.4, 0.1], 2001);
+        let (j, at) = f.slope_jumps([-2.4, 0.1], [2.4, 0.1], 2001).largest();
         assert!((j - 2.0).abs() < 1e-9 && at[0].abs() < 0.01, "kink: {j} at {at:?}");
         // A node-to-node wiggle of amplitude 0.01 on 0.25-spaced P2 nodes: slope jumps of
         // order 0.01 / 0.25 times a few.
         let (m, l, x) = state(|x, _| 0.01 * ((4.0 * x).round() as i64 % 2) as f64);
         let f = FieldsOnFace::new(&m, &l, &x);
-        let (j, _) = f.slope_jump([-2.4, 0.1], [2.4, 0.1], 2001);
+        let (j, _) = f.slope_jumps([-2.4, 0.1], [2.4, 0.1], 2001).largest();
         assert!(j > 0.04, "wiggle: {j}");
     }
     #[test]
@@ -265,12 +270,12 @@ mod tests {
         let mode = |v: f64| if ((2.0 * v).round() - 2.0 * v).abs() > 0.1 { 0.01 } else { 0.0 };
         let (m, l, x) = state(|x, _| 1.0 + mode(x));
         let f = FieldsOnFace::new(&m, &l, &x);
-        let (w, _) = f.wiggle([-2.4, 0.1], [2.4, 0.1], 4001);
+        let (w, _) = f.slope_jumps([-2.4, 0.1], [2.4, 0.1], 4001).largest_scallop();
         assert!(w > 0.005 && w < 0.02, "vertex mode: {w}");
         // A smooth field of the same size on the same mesh: an order of magnitude less.
         let (m, l, x) = state(|x, z| 1.0 + 0.05 * (x * 1.3).sin() * (z * 0.7).cos());
         let f = FieldsOnFace::new(&m, &l, &x);
-        let (w, _) = f.wiggle([-2.4, 0.1], [2.4, 0.1], 4001);
+        let (w, _) = f.slope_jumps([-2.4, 0.1], [2.4, 0.1], 4001).largest_scallop();
         assert!(w < 1e-3, "smooth: {w}");
     }
 }

@@ -133,7 +133,7 @@ pub struct PressureSummary {
     #[serde(default)]
     pub slope_jump_z0: Option<f64>,
     /// Node-to-node wiggles of the same lines: the largest scallop height |[dP/ds]| l / 8
-    /// (l the element's length along the line), in p_H (`FieldsOnFace::wiggle`; absent in
+    /// (l the element's length along the line), in p_H (`SlopeJumps::largest_scallop`; absent in
     /// summaries written before it existed).
     #[serde(default)]
     pub wiggle_x0: Option<f64>,
