@@ -266,8 +266,10 @@ pub const ADAPTIVE_X_MIN: f64 = -4.5;
 /// default that does not set it: the smallest factor measured that takes table2-ue2's
 /// largest pressure scallop along X = 0 at target 0.005 from 0.0025 p_H to 0.0005 p_H (the
 /// films unchanged); 0.03 does the same with a coarser first level further off, and 0.1
-/// closes the film of the 0.25 a first level at the side lobe. Hand-made meshes keep 0: on
-/// table2-ue2's (core 0.125 a) 0.01 raises hm by 2.3 % (docs/accuracy.md, "Smooth fields").
+/// closes the film of the 0.25 a first level at the side lobe (those three measured before
+/// the coefficient stopped growing at a/32). Hand-made meshes keep 0: their validation
+/// tables and regression references were measured without it (docs/accuracy.md, "Smooth
+/// fields").
 pub const ADAPTIVE_GRADIENT_JUMP: f64 = 0.01;
 
 /// Core box of a scene that asks for `output.subsurface` without a `[mesh]` table: element
