@@ -25,7 +25,7 @@ use super::marking::{goal_mark, longest_edges, next_field, within_radius, zone_m
 use super::{Context, Outcome};
 use crate::case::Scene;
 use crate::collective;
-use crate::ehl::driver::{EhlSolution, EhlSolver, Start};
+use crate::ehl::driver::{EhlSolution, EhlSolver, Milder, Start};
 use crate::ehl::post::FieldsOnFace;
 use crate::error::Error;
 use crate::mesh::size_field::SizeField;
@@ -236,9 +236,21 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 // is the Hertz pressure, not a coarser level's).
                 let plain = !(k >= 2 && prev.sol.continued);
                 let label = format!("level {}'s pressure ({} contact triangles)", k - 1, prev.setup.mesh.contact_tris.len());
+                // The previous level's state short of the scene, when it came through a
+                // continuation: this level's continuation starts its milder problem there.
+                let mf = prev.sol.milder.as_ref().map(|(_, _, x)| FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, x));
+                let pm = |x: f64, z: f64| mf.as_ref().and_then(|f| f.at(x, z)).map_or(0.0, |v| v.0);
+                let mild_label = format!("level {}'s state", k - 1);
+                let milder = prev.sol.milder.as_ref().zip(mf.as_ref()).map(|((name, ts, _), f)| Milder {
+                    parameter: name,
+                    ts,
+                    p: &pm,
+                    hc: f.stats().hc,
+                    label: &mild_label,
+                });
                 let solved = collective::agree(
                     &ctx.world,
-                    solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc: prev.hc, label: &label, plain }),
+                    solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder }),
                 );
                 match solved {
                     Ok(sol) => sol,

@@ -29,6 +29,25 @@ pub(super) struct NewtonOutcome {
     pub(super) steps: Vec<String>,
     /// The state came from a continuation (plain Newton from the start did not converge).
     pub(super) continued: bool,
+    /// The path of the continuation that reached the scene: its name, the values of t < 1
+    /// it converged at (ascending), and the state at the first of them (the milder problem
+    /// found), in the system's layout. A finer mesh's continuation starts there and ramps
+    /// through the same values ([`MilderStart`]).
+    pub(super) milder: Option<(&'static str, Vec<f64>, Vec<f64>)>,
+}
+
+/// A milder problem's state to start a continuation from: a coarser level's converged state
+/// at `ts[0]` of the continuation named `parameter`, interpolated onto this mesh (`x`, the
+/// system's layout), described by `label`; `ts` are the values of t < 1 the coarser
+/// level's ramp converged at. The milder problem is solved from it instead of from the
+/// scene's start: from the scene's film a milder problem's first step can cross H = 0 (a
+/// smaller alpha's film is thinner), while the coarser level's state is that problem's own
+/// solution. The ramp then steps through `ts`, where the coarser level's steps converged.
+pub(super) struct MilderStart<'a> {
+    pub(super) parameter: &'static str,
+    pub(super) ts: &'a [f64],
+    pub(super) x: &'a [f64],
+    pub(super) label: &'a str,
 }
 
 /// A scene parameter a continuation varies, with the scene's value: at t = 1 the scene
@@ -308,8 +327,11 @@ impl Newton<'_> {
 
     /// Ramps `h` from t (where `state` is converged) to the scene's problem at t = 1,
     /// multiplying t by the ramp's ratio, by its square root after each failure, and giving
-    /// up below a ratio of 1.05. Returns whether t = 1 converged, the last report and the
-    /// last converged state.
+    /// up below a ratio of 1.05; a value of `schedule` (where a coarser level's ramp
+    /// converged) between t and that is taken instead. Returns whether t = 1 converged,
+    /// the last report, the last converged state, and the values of t < 1 converged at
+    /// (from the first t on).
+    #[allow(clippy::type_complexity)]
     fn ramp(
         &mut self,
         from: &Scene,
@@ -317,29 +339,41 @@ impl Newton<'_> {
         mut t: f64,
         mut state: Vec<f64>,
         system: &mut dyn EhlProblem,
-    ) -> Result<(bool, Option<SolveReport>, Vec<f64>), Error> {
+        mut schedule: &[f64],
+    ) -> Result<(bool, Option<SolveReport>, Vec<f64>, Vec<f64>), Error> {
         let mut ratio = h.ramp.ratio;
         let mut last = None;
+        let mut below = vec![t];
         while t < 1.0 {
             // Within round-off of the end is the end (heavy-3gpa's load ramp by factors of
             // 2^(1/4) ended at t = 1 - 1e-16, then solved t = 1 again in 0 iterations).
             let next = if t * ratio > 1.0 - 1e-9 { 1.0 } else { t * ratio };
+            let planned = schedule.iter().copied().find(|&s| s > t * (1.0 + 1e-9)).filter(|&s| s < next);
+            let next = planned.unwrap_or(next);
             let (r, xs) = self.solve_at(from, h.parameter, next, system, &state, "")?;
             match xs {
                 Some(xs) => {
+                    if next < 1.0 {
+                        below.push(next);
+                    }
                     state = xs;
                     t = next;
                 }
                 None => {
-                    ratio = ratio.sqrt();
-                    if ratio < 1.05 {
-                        return Ok((false, Some(r), state));
+                    // A failed scheduled step is halved (in log t) from the step tried, and
+                    // the ramp goes on by its own ratio from there; such a step may be below
+                    // the smallest ratio once (the coarser level's path had small steps).
+                    ratio = planned.map_or(ratio, |s| s / t).sqrt();
+                    if planned.is_some() {
+                        schedule = &[];
+                    } else if ratio < 1.05 {
+                        return Ok((false, Some(r), state, below));
                     }
                 }
             }
             last = Some(r);
         }
-        Ok((true, last, state))
+        Ok((true, last, state, below))
     }
 }
 
@@ -359,6 +393,7 @@ pub(super) fn newton_with_continuation(
     j: &Matrix,
     owned: (usize, usize),
     local: usize,
+    milder: Option<MilderStart>,
 ) -> Result<NewtonOutcome, Error> {
     petsc::options::set_ours("-snes_linesearch_type", policy.line_search)?;
     set_newton_linear_solver(policy.reuses_lu)?;
@@ -407,6 +442,7 @@ pub(super) fn newton_with_continuation(
         last = Some(report);
     }
     let continued = state.is_none();
+    let mut reached_from: Option<(&'static str, Vec<f64>, Vec<f64>)> = None;
     // 2. If it failed: the continuations, each from a milder problem back to the base one.
     if state.is_none() && policy.continues {
         for h in homotopies(scene) {
@@ -414,13 +450,27 @@ pub(super) fn newton_with_continuation(
             if h.parameter.kinematic() && !system.set_velocity(velocity_field(scene)) {
                 continue;
             }
-            let Some((t, from)) = nw.search(&base, &h, system, x0, label)? else { continue };
-            let (done, r, xs) = nw.ramp(&base, &h, t, from, system)?;
+            // A coarser level's state of this continuation: its milder problem from there.
+            let mut found = None;
+            let mut schedule: &[f64] = &[];
+            if let Some(m) = milder.as_ref().filter(|m| m.parameter == h.parameter.name() && !m.ts.is_empty()) {
+                if let (_, Some(xs)) = nw.solve_at(&base, h.parameter, m.ts[0], system, m.x, &format!("{} at ", m.label))? {
+                    found = Some((m.ts[0], xs));
+                    schedule = m.ts;
+                }
+            }
+            if found.is_none() {
+                found = nw.search(&base, &h, system, x0, label)?;
+            }
+            let Some((t, from)) = found else { continue };
+            let first = from.clone();
+            let (done, r, xs, below) = nw.ramp(&base, &h, t, from, system, schedule)?;
             if r.is_some() {
                 last = r;
             }
             if done {
                 state = Some(xs);
+                reached_from = Some((h.parameter.name(), below, first));
                 break;
             }
             if h.parameter.kinematic() {
@@ -442,7 +492,7 @@ pub(super) fn newton_with_continuation(
     if let Some(from) = state.take_if(|_| staged) {
         let first = PENALTY_START / xi;
         let h = Homotopy { parameter: Parameter::Penalty(xi), ramp: Ramp { first, lowest: first, ratio: xi / PENALTY_START } };
-        let (done, r, xs) = nw.ramp(scene, &h, first, from, system)?;
+        let (done, r, xs, _) = nw.ramp(scene, &h, first, from, system, &[])?;
         if r.is_some() {
             last = r;
         }
@@ -466,7 +516,7 @@ pub(super) fn newton_with_continuation(
         )));
     };
     let last = last.clone();
-    Ok(NewtonOutcome { x: xs, report: last, newton_total: nw.iterations, steps: nw.steps, continued })
+    Ok(NewtonOutcome { x: xs, report: last, newton_total: nw.iterations, steps: nw.steps, continued, milder: reached_from })
 }
 
 #[cfg(test)]

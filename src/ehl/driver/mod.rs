@@ -22,7 +22,7 @@ pub use diagnostics::{check_jacobian, POLE_COLLAPSE};
 use policy::Attempt;
 pub use policy::{set_newton_defaults, set_newton_linear_solver, Coupling, CONDENSED_PREFIX};
 pub use problem::{lambda_bar, lubricant, velocity_field};
-pub use start::Start;
+pub use start::{Milder, Start};
 
 use super::condensed::CondensedSystem;
 use super::layout::Layout;
@@ -34,7 +34,7 @@ use crate::mesh::{Mesh, Partition};
 use crate::petsc::snes::SolveReport;
 use crate::petsc::{self, Matrix};
 use crate::solid::{assembly, dofmap::DofMap};
-use continuation::newton_with_continuation;
+use continuation::{newton_with_continuation, MilderStart};
 use policy::Policy;
 use problem::ehl_params;
 use start::{elastic_start, rigid_start, start_h0};
@@ -53,6 +53,10 @@ pub struct EhlSolution {
     pub coupling: Coupling,
     /// Plain Newton from the start failed and a continuation found the state.
     pub continued: bool,
+    /// The path of the continuation that found the state: its name, the values of t < 1
+    /// it converged at, and the state at the first (monolithic layout). A finer level
+    /// starts its continuation there ([`Milder`]).
+    pub milder: Option<(&'static str, Vec<f64>, Vec<f64>)>,
 }
 
 /// The lubricated solver of one mesh: the parts that do not depend on the operating
@@ -207,6 +211,18 @@ fn solve_condensed(
     let mut system = CondensedSystem::new(mesh, comp, ctx.size, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene));
     let cl = system.layout.clone();
     system.debug_mesh = Some(mesh);
+    // The condensed state of a pressure field and central film: the pressure at the
+    // nodes and H0 over its deflection.
+    let state_of = |system: &CondensedSystem, p: &dyn Fn(f64, f64) -> f64, hc: f64| -> Result<Vec<f64>, Error> {
+        let mut x0 = vec![0.0; cl.total()];
+        for (j, &n) in comp.cols.iter().enumerate() {
+            let c = mesh.nodes[n as usize];
+            x0[j] = p(c[0], c[2]);
+        }
+        let uy0 = system.uy(&x0);
+        x0[cl.h0()] = start_h0(hc, mesh, &|n| uy0[cl.face_index[n as usize] as usize])?;
+        Ok(x0)
+    };
     let mut x0 = vec![0.0; cl.total()];
     let label = match start {
         Start::Previous(prev) => {
@@ -219,12 +235,7 @@ fn solve_condensed(
         Start::Hertz | Start::Pressure { .. } => {
             // The pressure and its (condensed) deflection.
             let (p, hc) = start.pressure(scene);
-            for (j, &n) in comp.cols.iter().enumerate() {
-                let c = mesh.nodes[n as usize];
-                x0[j] = p(c[0], c[2]);
-            }
-            let uy0 = system.uy(&x0);
-            x0[cl.h0()] = start_h0(hc, mesh, &|n| uy0[cl.face_index[n as usize] as usize])?;
+            x0 = state_of(&system, p, hc)?;
             if comp.is_rigid() && matches!(start, Start::Hertz) {
                 rigid_start(ctx, &mut system, &mut x0, (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]), cl.local(ctx.rank))?;
                 "the rigid start"
@@ -252,31 +263,42 @@ fn solve_condensed(
         cl.n_p,
         if comp.is_rigid() { "sparse" } else { "dense" }
     ));
+    let policy = Policy::for_start(&start, attempt);
+    let milder = match start.milder().filter(|_| policy.continues) {
+        Some(m) => Some((m, state_of(&system, m.p, m.hc)?)),
+        None => None,
+    };
     let out = newton_with_continuation(
         ctx,
         scene,
         &mut system,
         &x0,
         label,
-        Policy::for_start(&start, attempt),
+        policy,
         &j,
         (lo, hi),
         cl.local(ctx.rank),
+        milder.as_ref().map(|(m, x)| MilderStart { parameter: m.parameter, ts: m.ts, x, label: m.label }),
     )?;
     let solve_s = t1.elapsed().as_secs_f64();
     // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
-    let uy = system.uy(&out.x);
-    let mut x = vec![0.0; layout.total()];
-    for (j, &n) in comp.cols.iter().enumerate() {
-        x[layout.p[n as usize] as usize] = out.x[j];
-    }
-    for (i, &n) in comp.rows.iter().enumerate() {
-        let d = layout.u[n as usize][1];
-        if d >= 0 {
-            x[d as usize] = uy[i];
+    let monolithic = |xc: &[f64]| {
+        let uy = system.uy(xc);
+        let mut x = vec![0.0; layout.total()];
+        for (j, &n) in comp.cols.iter().enumerate() {
+            x[layout.p[n as usize] as usize] = xc[j];
         }
-    }
-    x[layout.h0 as usize] = out.x[cl.h0()];
+        for (i, &n) in comp.rows.iter().enumerate() {
+            let d = layout.u[n as usize][1];
+            if d >= 0 {
+                x[d as usize] = uy[i];
+            }
+        }
+        x[layout.h0 as usize] = xc[cl.h0()];
+        x
+    };
+    let x = monolithic(&out.x);
+    let milder = out.milder.map(|(name, ts, xc)| (name, ts, monolithic(&xc)));
     let coupling = if comp.is_rigid() { Coupling::Rigid } else { Coupling::Condensed };
     Ok(EhlSolution {
         x,
@@ -287,6 +309,7 @@ fn solve_condensed(
         solve_s,
         coupling,
         continued: out.continued,
+        milder,
     })
 }
 
@@ -308,29 +331,38 @@ fn solve_monolithic(
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
     let k = assembly::assemble_stiffness(comm, mesh, part, dofs, ctx.rank, eq.nu)?;
+    // Initial iterate of a pressure field and central film: the pressure, its
+    // displacement, H0 from the central film.
+    let state_of = |p: &dyn Fn(f64, f64) -> f64, hc: f64| -> Result<Vec<f64>, Error> {
+        let u_dry = elastic_start(comm, ctx, mesh, part, dofs, &k, eq.nu, p)?;
+        let mut x0 = vec![0.0; layout.total()];
+        for n in 0..mesh.nodes.len() {
+            for c in 0..3 {
+                let (d, g) = (dofs.node_dof[n][c], layout.u[n][c]);
+                if d >= 0 {
+                    x0[g as usize] = u_dry[d as usize];
+                }
+            }
+            let d = layout.p[n];
+            if d >= 0 {
+                let c = mesh.nodes[n];
+                x0[d as usize] = p(c[0], c[2]);
+            }
+        }
+        x0[layout.h0 as usize] = start_h0(hc, mesh, &|n| layout.uy(&x0, n))?;
+        Ok(x0)
+    };
     let x0 = match start {
         Start::Previous(prev) => prev.to_vec(),
         Start::Hertz | Start::Pressure { .. } => {
             let (p, hc) = start.pressure(scene);
-            let u_dry = elastic_start(comm, ctx, mesh, part, dofs, &k, eq.nu, p)?;
-            // Initial iterate: the start pressure, its displacement, H0 from the central film.
-            let mut x0 = vec![0.0; layout.total()];
-            for n in 0..mesh.nodes.len() {
-                for c in 0..3 {
-                    let (d, g) = (dofs.node_dof[n][c], layout.u[n][c]);
-                    if d >= 0 {
-                        x0[g as usize] = u_dry[d as usize];
-                    }
-                }
-                let d = layout.p[n];
-                if d >= 0 {
-                    let c = mesh.nodes[n];
-                    x0[d as usize] = p(c[0], c[2]);
-                }
-            }
-            x0[layout.h0 as usize] = start_h0(hc, mesh, &|n| layout.uy(&x0, n))?;
-            x0
+            state_of(p, hc)?
         }
+    };
+    let policy = Policy::for_start(&start, attempt);
+    let milder = match start.milder().filter(|_| policy.continues) {
+        Some(m) => Some((m, state_of(m.p, m.hc)?)),
+        None => None,
     };
     let label = start.label();
     let params = ehl_params(scene, eq.nu, half);
@@ -360,10 +392,11 @@ fn solve_monolithic(
         &mut system,
         &x0,
         label,
-        Policy::for_start(&start, attempt),
+        policy,
         &j,
         (lo, hi),
         layout.local(ctx.rank),
+        milder.as_ref().map(|(m, x)| MilderStart { parameter: m.parameter, ts: m.ts, x, label: m.label }),
     )?;
     let solve_s = t1.elapsed().as_secs_f64();
     Ok(EhlSolution {
@@ -375,5 +408,6 @@ fn solve_monolithic(
         solve_s,
         coupling: Coupling::Monolithic,
         continued: out.continued,
+        milder: out.milder,
     })
 }

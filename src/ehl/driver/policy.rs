@@ -148,7 +148,9 @@ impl Attempt {
     /// - A coarser level that itself needed the continuation (`plain: false`): the
     ///   continuation at once. Plain Newton failed on every level after the first at
     ///   M = 1000, L = 10 and M = 100, L = 20 (levels 1-3), and on the 449k-unknown level it
-    ///   cost 540 s before the continuation started.
+    ///   cost 540 s before the continuation started. Its milder problem starts from the
+    ///   coarser level's own state of that problem when the start carries one
+    ///   ([`super::Milder`]).
     pub(super) fn ladder(start: &Start, monolithic: bool) -> Vec<Attempt> {
         let first = Attempt { reuse_lu: monolithic, ..Attempt::PLAIN };
         match start {
@@ -227,7 +229,7 @@ mod tests {
     #[test]
     fn another_meshs_pressure_continues_from_itself_after_a_short_plain_newton() {
         let p = |_: f64, _: f64| 0.0;
-        let coarse = Start::Pressure { p: &p, hc: 0.5, label: "level 0", plain: true };
+        let coarse = Start::Pressure { p: &p, hc: 0.5, label: "level 0", plain: true, milder: None };
         for monolithic in [true, false] {
             let ladder = Attempt::ladder(&coarse, monolithic);
             assert_eq!(ladder.len(), 2);
@@ -239,7 +241,7 @@ mod tests {
             assert!(cont.bt_after_domain_error() && !plain.bt_after_domain_error());
         }
         // After a coarser level that needed the continuation: the continuation at once.
-        let hard = Start::Pressure { p: &p, hc: 0.5, label: "level 1", plain: false };
+        let hard = Start::Pressure { p: &p, hc: 0.5, label: "level 1", plain: false, milder: None };
         assert_eq!(Attempt::ladder(&hard, true), vec![Attempt { reuse_lu: false, continues: true }]);
         // A sweep's previous point: the LU reuse on the monolithic coupling, then exact Newton.
         let x = [0.0; 4];

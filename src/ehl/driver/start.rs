@@ -26,7 +26,20 @@ pub enum Start<'s> {
     /// is `hc` (dimensionless). `label` names it in the log. With `plain` false plain
     /// Newton is skipped and the continuation runs from it at once (the coarser level
     /// itself needed the continuation: see [`super::policy::Attempt::ladder`]).
-    Pressure { p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str, plain: bool },
+    Pressure { p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str, plain: bool, milder: Option<Milder<'s>> },
+}
+
+/// A coarser level's path through a continuation: the pressure field at `ts[0]` of the
+/// continuation named `parameter`, with its central film `hc`, and the values of t < 1
+/// its ramp converged at. The continuation from a [`Start::Pressure`] solves its milder
+/// problem from that field and ramps through the same values.
+#[derive(Clone, Copy)]
+pub struct Milder<'s> {
+    pub parameter: &'static str,
+    pub ts: &'s [f64],
+    pub p: &'s dyn Fn(f64, f64) -> f64,
+    pub hc: f64,
+    pub label: &'s str,
 }
 
 impl<'s> Start<'s> {
@@ -36,6 +49,14 @@ impl<'s> Start<'s> {
         match *self {
             Start::Pressure { p, hc, .. } => (p, hc),
             _ => (&hertz_load::hertz_pressure, hc_guess(scene)),
+        }
+    }
+
+    /// A coarser level's state short of the scene, if the start carries one.
+    pub(super) fn milder(&self) -> Option<Milder<'s>> {
+        match *self {
+            Start::Pressure { milder, .. } => milder,
+            _ => None,
         }
     }
 
