@@ -238,12 +238,12 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 let label = format!("level {}'s pressure ({} contact triangles)", k - 1, prev.setup.mesh.contact_tris.len());
                 // The previous level's state short of the scene, when it came through a
                 // continuation: this level's continuation starts its milder problem there.
-                let mf = prev.sol.milder.as_ref().map(|(_, _, x)| FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, x));
+                let mf = prev.sol.milder.as_ref().map(|path| FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &path.x));
                 let pm = |x: f64, z: f64| mf.as_ref().and_then(|f| f.at(x, z)).map_or(0.0, |v| v.0);
                 let mild_label = format!("level {}'s state", k - 1);
-                let milder = prev.sol.milder.as_ref().zip(mf.as_ref()).map(|((name, ts, _), f)| Milder {
-                    parameter: name,
-                    ts,
+                let milder = prev.sol.milder.as_ref().zip(mf.as_ref()).map(|(path, f)| Milder {
+                    parameter: path.parameter,
+                    ts: &path.ts,
                     p: &pm,
                     hc: f.stats().hc,
                     label: &mild_label,

@@ -497,8 +497,7 @@ impl Problem for CondensedSystem<'_> {
             let at = self.face_xz(k).map(|c| format!(" (X, Z) = ({:.3}, {:.3})", c[0], c[1])).unwrap_or_default();
             return Ok(Eval::Domain(format!("film thickness H = {:.3e} at face node {}{at}", h[k], self.comp.rows[k])));
         }
-        let p_max = x[..self.layout.n_p].iter().fold(f64::NEG_INFINITY, |m, &v| if m.is_nan() || v.is_nan() { f64::NAN } else { m.max(v) });
-        if let Some(why) = self.lubricant.out_of_range(p_max) {
+        if let Some(why) = self.lubricant.out_of_range(x[..self.layout.n_p].iter().copied()) {
             return Ok(Eval::Domain(why));
         }
         let (lo, hi) = self.owned();

@@ -29,11 +29,20 @@ pub(super) struct NewtonOutcome {
     pub(super) steps: Vec<String>,
     /// The state came from a continuation (plain Newton from the start did not converge).
     pub(super) continued: bool,
-    /// The path of the continuation that reached the scene: its name, the values of t < 1
-    /// it converged at (ascending), and the state at the first of them (the milder problem
-    /// found), in the system's layout. A finer mesh's continuation starts there and ramps
-    /// through the same values ([`MilderStart`]).
-    pub(super) milder: Option<(&'static str, Vec<f64>, Vec<f64>)>,
+    /// The path of the continuation that reached the scene, the state in the system's
+    /// layout. A finer mesh's continuation starts there and ramps through the same values
+    /// ([`MilderStart`]).
+    pub(super) milder: Option<ContinuationPath>,
+}
+
+/// The path of a continuation that reached the scene: the continuation's name, the values
+/// of t < 1 its ramp converged at (ascending), and the state at the first of them (the
+/// milder problem found).
+#[derive(Debug, Clone)]
+pub struct ContinuationPath {
+    pub parameter: &'static str,
+    pub ts: Vec<f64>,
+    pub x: Vec<f64>,
 }
 
 /// A milder problem's state to start a continuation from: a coarser level's converged state
@@ -442,7 +451,7 @@ pub(super) fn newton_with_continuation(
         last = Some(report);
     }
     let continued = state.is_none();
-    let mut reached_from: Option<(&'static str, Vec<f64>, Vec<f64>)> = None;
+    let mut reached_from: Option<ContinuationPath> = None;
     // 2. If it failed: the continuations, each from a milder problem back to the base one.
     if state.is_none() && policy.continues {
         for h in homotopies(scene) {
@@ -470,7 +479,7 @@ pub(super) fn newton_with_continuation(
             }
             if done {
                 state = Some(xs);
-                reached_from = Some((h.parameter.name(), below, first));
+                reached_from = Some(ContinuationPath { parameter: h.parameter.name(), ts: below, x: first });
                 break;
             }
             if h.parameter.kinematic() {

@@ -34,6 +34,7 @@ use crate::mesh::{Mesh, Partition};
 use crate::petsc::snes::SolveReport;
 use crate::petsc::{self, Matrix};
 use crate::solid::{assembly, dofmap::DofMap};
+pub use continuation::ContinuationPath;
 use continuation::{newton_with_continuation, MilderStart};
 use policy::Policy;
 use problem::ehl_params;
@@ -53,10 +54,9 @@ pub struct EhlSolution {
     pub coupling: Coupling,
     /// Plain Newton from the start failed and a continuation found the state.
     pub continued: bool,
-    /// The path of the continuation that found the state: its name, the values of t < 1
-    /// it converged at, and the state at the first (monolithic layout). A finer level
-    /// starts its continuation there ([`Milder`]).
-    pub milder: Option<(&'static str, Vec<f64>, Vec<f64>)>,
+    /// The path of the continuation that found the state (monolithic layout). A finer
+    /// level starts its continuation there ([`Milder`]).
+    pub milder: Option<ContinuationPath>,
 }
 
 /// The lubricated solver of one mesh: the parts that do not depend on the operating
@@ -298,7 +298,7 @@ fn solve_condensed(
         x
     };
     let x = monolithic(&out.x);
-    let milder = out.milder.map(|(name, ts, xc)| (name, ts, monolithic(&xc)));
+    let milder = out.milder.map(|path| ContinuationPath { x: monolithic(&path.x), ..path });
     let coupling = if comp.is_rigid() { Coupling::Rigid } else { Coupling::Condensed };
     Ok(EhlSolution {
         x,
