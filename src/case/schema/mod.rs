@@ -272,6 +272,14 @@ pub const ADAPTIVE_X_MIN: f64 = -4.5;
 /// fields").
 pub const ADAPTIVE_GRADIENT_JUMP: f64 = 0.01;
 
+/// The gradient-jump factor an adaptive level is solved again with when Newton does not
+/// converge with a smaller one (positive): at Moes M = 100, L = 20 (alpha p_H = 34) the
+/// outlet spike is one element wide on the 0.0625 a and 0.03125 a levels and the
+/// pressure-viscosity continuation stops short of the scene's alpha with c_J = 0.01 and 0.1;
+/// with 1 every level converges, pmax drops (the spike is smoothed at the mesh scale) and hc,
+/// hm move by 0.1 % and 0.3 % (docs/accuracy.md, "Newton on fine levels at high M and L").
+pub const RAISED_GRADIENT_JUMP: f64 = 1.0;
+
 /// Core box of a scene that asks for `output.subsurface` without a `[mesh]` table: element
 /// size, half width and depth (units of a). Measured on the dry Hertz scene against Huber
 /// and Hamilton (docs/subsurface.md): on the plain default mesh (0.25 a on the face)

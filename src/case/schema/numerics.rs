@@ -136,7 +136,7 @@ pub const REYNOLDS_FIELDS: &[Field] = &[
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0")),
     f!("crosswind_diffusion", "crosswind diffusion factor delta_CD (eps_CD = delta_CD h_e |rho' H u|, across the streamlines only; removes the crosswind stripes; 0 = off)", "",
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0")),
-    f!("gradient_jump", "gradient-jump factor c_J: the pressure-slope jumps across the contact edges are penalised with gamma = c_J kappa |v| min(h, a/32)^3 (consistent: zero for a smooth pressure; removes the node-to-node wiggles of the P2 pressure in the Hertz zone; 0 = off)", "",
+    f!("gradient_jump", "gradient-jump factor c_J: the pressure-slope jumps across the contact edges are penalised with gamma = c_J kappa |v| min(h, a/32)^3 (consistent: zero for a smooth pressure; removes the node-to-node wiggles of the P2 pressure in the Hertz zone; an adaptive level that does not converge with a factor below 1 is solved again with 1; 0 = off)", "",
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0; 0.01 when refined to an accuracy target without a [mesh] table")),
     f!("coupling", "how Newton couples film and solid: the elastic block condensed onto the contact face (dense LU, fast on small meshes) or one sparse monolithic matrix (MUMPS; fast on fine meshes); auto = condensed up to 4,000 pressure unknowns (a sweep: 8,000)", "",
         Kind::Choice(Coupling::NAMES), Presence::Default("\"auto\"")),
