@@ -194,10 +194,9 @@ struct Solved {
 /// Collective. When the target cannot be reached (`max_levels`, `max_unknowns`, every
 /// triangle at the smallest size) the last level's result is written with its estimated
 /// error and the returned [`Outcome::ShortOfTarget`] says why (exit 4).
-pub fn run(ctx: &Context, given: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<Outcome, Error> {
+pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<Outcome, Error> {
     // The scene as solved: the gradient-jump factor may be raised on the way (below).
-    let mut own = given.clone();
-    let scene = given;
+    let mut own = scene.clone();
     let acc = scene.accuracy;
     let target = acc.target;
     let max_levels = acc.max_levels as usize;
@@ -272,14 +271,11 @@ pub fn run(ctx: &Context, given: &Scene, earlier: Option<&super::restart::Earlie
                         if crate::interrupt::agreed() == 0
                             && scene.reynolds.gradient_jump > 0.0
                             && scene.reynolds.gradient_jump < RAISED_GRADIENT_JUMP
-                            && collective::all(
-                                &ctx.world,
-                                matches!(e.root(), Error::NotConverged(_)) && !e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE),
-                            ) =>
+                            && newton_failed(ctx, &e) =>
                     {
                         ctx.log(format!(
                             "accuracy: level {k} did not converge ({}); again on the same mesh with the gradient-jump factor reynolds.gradient_jump raised from {} to {RAISED_GRADIENT_JUMP} for this level and the ones after",
-                            e.to_string().split("; path:").next().unwrap_or_default(),
+                            reason(&e),
                             scene.reynolds.gradient_jump
                         ));
                         drop(solver);
@@ -293,7 +289,7 @@ pub fn run(ctx: &Context, given: &Scene, earlier: Option<&super::restart::Earlie
                     Err(e) if crate::interrupt::agreed() == 0 && zone_retry == Some(k) => {
                         ctx.log(format!(
                             "accuracy: level {k} did not converge on its goal-oriented mesh ({}); again with level {}'s pressurised zone refined",
-                            e.to_string().split("; path:").next().unwrap_or_default(),
+                            reason(&e),
                             k - 1
                         ));
                         let edges = longest_edges(&prev.setup.mesh);
@@ -324,16 +320,8 @@ pub fn run(ctx: &Context, given: &Scene, earlier: Option<&super::restart::Earlie
                 // solved again; a film that closes at a spin pole closes on any mesh.
                 // Every rank decides the same: only Newton's own failure (the same on every
                 // rank) is retried, not one rank's local fault.
-                Err(e)
-                    if crate::interrupt::agreed() == 0
-                        && first_retries < FIRST_LEVEL_RETRIES
-                        && collective::all(
-                            &ctx.world,
-                            matches!(e.root(), Error::NotConverged(_)) && !e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE),
-                        ) =>
-                {
-                    let why = e.to_string();
-                    let why = format!("did not converge on its mesh ({})", why.split("; path:").next().unwrap_or(&why));
+                Err(e) if crate::interrupt::agreed() == 0 && first_retries < FIRST_LEVEL_RETRIES && newton_failed(ctx, &e) => {
+                    let why = format!("did not converge on its mesh ({})", reason(&e));
                     field = Some(first_level_again(ctx, &setup.mesh, growth, &why));
                     first_retries += 1;
                     continue;
@@ -465,6 +453,19 @@ pub fn run(ctx: &Context, given: &Scene, earlier: Option<&super::restart::Earlie
         }
         previous = Some(here);
     }
+}
+
+/// Whether `e` is Newton's own failure, the same on every rank (not one rank's local
+/// fault), and not a film closing at a spin pole (which closes on any mesh): the failures
+/// after which a level is solved again. Collective.
+fn newton_failed(ctx: &Context, e: &Error) -> bool {
+    collective::all(&ctx.world, matches!(e.root(), Error::NotConverged(_)) && !e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE))
+}
+
+/// Why `e` stopped Newton, without the path of solves it lists, for the log.
+fn reason(e: &Error) -> String {
+    let why = e.to_string();
+    why.split("; path:").next().unwrap_or(&why).to_string()
 }
 
 /// After level `k` stopped with `e`: when the time budget was spent (and a level converged
