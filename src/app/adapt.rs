@@ -54,8 +54,13 @@ pub struct Level {
     pub pressure_unknowns: usize,
     pub contact_triangles: usize,
     pub min_size: f64,
+    /// Newton iterations of the attempt that converged.
     pub newton_iterations: usize,
+    /// Wall time of the level: every attempt, its adjoint and the next level's marking.
     pub seconds: f64,
+    /// The part of `seconds` spent in attempts that did not converge (the level solved
+    /// again on the same or another mesh).
+    pub failed_seconds: f64,
     /// hc, hm (m), pmax (Pa).
     pub hc: f64,
     pub hm: f64,
@@ -214,6 +219,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     // The level that may be meshed again with zone marking if it does not converge on its
     // goal-oriented mesh.
     let mut zone_retry: Option<usize> = None;
+    // The level solved again with the load and speed continuations and the Hertz start.
+    let mut full_ladder: Option<usize> = None;
+    // Seconds of the present level's attempts that did not converge: part of its time.
+    let mut tried_s = 0.0;
     loop {
         let scene = &own;
         // The level being solved: one per converged level (a retried first level stays 0).
@@ -254,9 +263,16 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     hc: f.stats().hc,
                     label: &mild_label,
                 });
+                // While the gradient-jump factor can still be raised, a level that fails the
+                // continuations nearest the scene is solved again with it raised (below)
+                // before the load and speed continuations and the Hertz start: at M = 100,
+                // L = 20 those cost 330 s on level 3 and never converged from a coarser
+                // level's pressure. A failure the raise does not answer gets them after all.
+                let raisable = scene.reynolds.gradient_jump > 0.0 && scene.reynolds.gradient_jump < RAISED_GRADIENT_JUMP;
+                let last_resorts = !raisable || full_ladder == Some(k);
                 let solved = collective::agree(
                     &ctx.world,
-                    solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder }),
+                    solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder, last_resorts }),
                 );
                 match solved {
                     Ok(sol) => sol,
@@ -267,12 +283,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     // the alpha ramp stops at 55-63 of 68.3 GPa^-1; with c_J = 1 every level
                     // converges and hc, hm move by 0.1 %, 0.3 % (docs/accuracy.md, "Newton
                     // on fine levels at high M and L").
-                    Err(e)
-                        if crate::interrupt::agreed() == 0
-                            && scene.reynolds.gradient_jump > 0.0
-                            && scene.reynolds.gradient_jump < RAISED_GRADIENT_JUMP
-                            && newton_failed(ctx, &e) =>
-                    {
+                    Err(e) if crate::interrupt::agreed() == 0 && raisable && newton_failed(ctx, &e) => {
                         ctx.log(format!(
                             "accuracy: level {k} did not converge ({}); again on the same mesh with the gradient-jump factor reynolds.gradient_jump raised from {} to {RAISED_GRADIENT_JUMP} for this level and the ones after",
                             reason(&e),
@@ -280,6 +291,17 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         ));
                         drop(solver);
                         own.reynolds.gradient_jump = RAISED_GRADIENT_JUMP;
+                        tried_s += t0.elapsed().as_secs_f64();
+                        continue;
+                    }
+                    Err(e) if crate::interrupt::agreed() == 0 && !last_resorts => {
+                        ctx.log(format!(
+                            "accuracy: level {k} did not converge ({}); again on the same mesh with the load and speed continuations and the Hertz start",
+                            reason(&e)
+                        ));
+                        drop(solver);
+                        full_ladder = Some(k);
+                        tried_s += t0.elapsed().as_secs_f64();
                         continue;
                     }
                     // A goal-oriented level that does not converge is meshed again with the
@@ -296,6 +318,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         let marked = zone_mark(&pf, &edges);
                         field = Some(Arc::new(next_field(&prev.setup.mesh, &edges, &marked, growth)));
                         zone_retry = None;
+                        tried_s += t0.elapsed().as_secs_f64();
                         continue;
                     }
                     // A level that does not converge leaves the last converged one as the
@@ -324,6 +347,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     let why = format!("did not converge on its mesh ({})", reason(&e));
                     field = Some(first_level_again(ctx, &setup.mesh, growth, &why));
                     first_retries += 1;
+                    tried_s += t0.elapsed().as_secs_f64();
                     continue;
                 }
                 Err(e) => return Err(e),
@@ -342,6 +366,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             );
             field = Some(first_level_again(ctx, &setup.mesh, growth, &why));
             first_retries += 1;
+            tried_s += t0.elapsed().as_secs_f64();
             continue;
         }
         if unphysical {
@@ -359,7 +384,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             contact_triangles: setup.mesh.contact_tris.len(),
             min_size,
             newton_iterations: sol.newton_total,
-            seconds: t0.elapsed().as_secs_f64(),
+            seconds: tried_s + t0.elapsed().as_secs_f64(),
+            failed_seconds: tried_s,
             hc: st.hc * hs,
             hm: st.hm * hs,
             hm_at: st.hm_at,
@@ -376,12 +402,13 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let level = levels.last_mut().expect("the level just pushed");
         level.est = est;
         ctx.log(format!(
-            "accuracy: level {k}: {} contact triangles (smallest {:.4} a), {} unknowns, {} Newton its, {:.1} s: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}; estimated error {}",
+            "accuracy: level {k}: {} contact triangles (smallest {:.4} a), {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}; estimated error {}",
             level.contact_triangles,
             level.min_size,
             n_u + n_p + 1,
             level.newton_iterations,
             level.seconds,
+            if level.failed_seconds > 0.0 { format!(" ({:.1} s of them in attempts that failed)", level.failed_seconds) } else { String::new() },
             level.hc,
             level.hm,
             level.hm_at[0],
@@ -429,7 +456,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         };
         drop(adjoint);
         // A level's time includes its adjoint and the marking of the next one.
-        levels.last_mut().expect("the level just pushed").seconds = t0.elapsed().as_secs_f64();
+        levels.last_mut().expect("the level just pushed").seconds = tried_s + t0.elapsed().as_secs_f64();
+        tried_s = 0.0;
         let condensation_s = solver.condensation_s;
         drop(fields);
         drop(solver);
@@ -545,7 +573,7 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
             let mut v = json!({
                 "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
                 "contact_triangles": l.contact_triangles, "smallest_size_a": l.min_size,
-                "newton_iterations": l.newton_iterations, "seconds": l.seconds,
+                "newton_iterations": l.newton_iterations, "seconds": l.seconds, "failed_attempts_seconds": l.failed_seconds,
                 "hc_m": l.hc, "hm_m": l.hm, "hm_at_a": l.hm_at, "pmax_pa": l.pmax,
             });
             // The first level has no estimate: the key is left out (summary.json holds no null).
@@ -620,6 +648,7 @@ mod tests {
             min_size: 0.25,
             newton_iterations: 0,
             seconds: 0.0,
+            failed_seconds: 0.0,
             hc,
             hm: 1.0,
             hm_at: [0.0, -0.9],

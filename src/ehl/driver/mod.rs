@@ -149,7 +149,8 @@ impl<'a> EhlSolver<'a> {
     /// Solves the scene's operating point from `start`: the attempts of
     /// [`Attempt::ladder`] in order (plain Newton, the monolithic LU reused; from another
     /// mesh's pressure then the continuation from that pressure), then the Hertz start with
-    /// its automatic continuation. Collective.
+    /// its automatic continuation (not after a start without its last resorts: its last
+    /// failure is returned). Collective.
     pub fn solve_from(&self, ctx: &Context, scene: &Scene, start: Start) -> Result<EhlSolution, Error> {
         let once = |start: Start, attempt: Attempt| match &self.comp {
             None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, attempt),
@@ -161,6 +162,7 @@ impl<'a> EhlSolver<'a> {
                 match once(start, *attempt) {
                     Ok(s) => return Ok(s),
                     Err(e) if crate::interrupt::agreed() != 0 => return Err(e),
+                    Err(e) if k + 1 == ladder.len() && !start.last_resorts() => return Err(e),
                     Err(e) => {
                         let next = ladder.get(k + 1).map_or("the Hertz start", |a| a.describe());
                         ctx.log(format!("from {}: {} failed ({e}); now {next}", start.label(), attempt.describe()));

@@ -78,6 +78,9 @@ pub(super) struct Policy {
     pub(super) reuses_lu: bool,
     /// Plain Newton at the scene's problem comes first (the continuation only after it).
     pub(super) plain_first: bool,
+    /// The load and speed continuations follow the tilt and pressure-viscosity ones
+    /// ([`Start::last_resorts`]).
+    pub(super) last_resorts: bool,
 }
 
 impl Policy {
@@ -109,6 +112,7 @@ impl Policy {
             // The continuation attempt follows plain Newton from the same start, which
             // failed: it goes straight to the continuation.
             plain_first: hertz || !attempt.continues,
+            last_resorts: start.last_resorts(),
         }
     }
 }
@@ -229,7 +233,7 @@ mod tests {
     #[test]
     fn another_meshs_pressure_continues_from_itself_after_a_short_plain_newton() {
         let p = |_: f64, _: f64| 0.0;
-        let coarse = Start::Pressure { p: &p, hc: 0.5, label: "level 0", plain: true, milder: None };
+        let coarse = Start::Pressure { p: &p, hc: 0.5, label: "level 0", plain: true, milder: None, last_resorts: true };
         for monolithic in [true, false] {
             let ladder = Attempt::ladder(&coarse, monolithic);
             assert_eq!(ladder.len(), 2);
@@ -241,7 +245,7 @@ mod tests {
             assert!(cont.bt_after_domain_error() && !plain.bt_after_domain_error());
         }
         // After a coarser level that needed the continuation: the continuation at once.
-        let hard = Start::Pressure { p: &p, hc: 0.5, label: "level 1", plain: false, milder: None };
+        let hard = Start::Pressure { p: &p, hc: 0.5, label: "level 1", plain: false, milder: None, last_resorts: true };
         assert_eq!(Attempt::ladder(&hard, true), vec![Attempt { reuse_lu: false, continues: true }]);
         // A sweep's previous point: the LU reuse on the monolithic coupling, then exact Newton.
         let x = [0.0; 4];
@@ -249,7 +253,12 @@ mod tests {
         assert_eq!(Attempt::ladder(&Start::Previous(&x), false), vec![Attempt::PLAIN]);
         assert!(!Policy::for_start(&Start::Previous(&x), Attempt::PLAIN).continues);
         let hertz = Policy::for_start(&Start::Hertz, Attempt::PLAIN);
-        assert!(hertz.continues && hertz.plain_first && !hertz.reuses_lu);
+        assert!(hertz.continues && hertz.plain_first && !hertz.reuses_lu && hertz.last_resorts);
+        // A caller with a remedy of its own: the continuation without the last resorts.
+        let own = Start::Pressure { p: &p, hc: 0.5, label: "level 2", plain: false, milder: None, last_resorts: false };
+        let ladder = Attempt::ladder(&own, true);
+        assert!(ladder.iter().all(|a| !Policy::for_start(&own, *a).last_resorts));
+        assert!(!own.last_resorts() && hard.last_resorts());
     }
 
     #[test]

@@ -25,8 +25,11 @@ pub enum Start<'s> {
     /// converged solution, interpolated), its deflection, and H0 so that the central film
     /// is `hc` (dimensionless). `label` names it in the log. With `plain` false plain
     /// Newton is skipped and the continuation runs from it at once (the coarser level
-    /// itself needed the continuation: see [`super::policy::Attempt::ladder`]).
-    Pressure { p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str, plain: bool, milder: Option<Milder<'s>> },
+    /// itself needed the continuation: see [`super::policy::Attempt::ladder`]). With
+    /// `last_resorts` false the load and speed continuations and the Hertz start are not
+    /// tried after the continuations nearest the scene (tilt, pressure-viscosity) fail:
+    /// the caller has a remedy of its own to try first.
+    Pressure { p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str, plain: bool, milder: Option<Milder<'s>>, last_resorts: bool },
 }
 
 /// A coarser level's path through a continuation: the pressure field at `ts[0]` of the
@@ -57,6 +60,15 @@ impl<'s> Start<'s> {
         match *self {
             Start::Pressure { milder, .. } => milder,
             _ => None,
+        }
+    }
+
+    /// Whether the load and speed continuations and the Hertz start follow when the
+    /// attempts from this start fail (see [`Start::Pressure`]).
+    pub(super) fn last_resorts(&self) -> bool {
+        match *self {
+            Start::Pressure { last_resorts, .. } => last_resorts,
+            _ => true,
         }
     }
 
