@@ -70,7 +70,10 @@ pub(super) struct Policy {
     /// The MUMPS LU is rebuilt every third Newton step, GMRES solving on it in between
     /// ([`set_newton_linear_solver`]); otherwise an LU at every step (exact Newton). Only
     /// on the monolithic coupling and from a start near the solution (another mesh's
-    /// pressure, a previous operating point): from the Hertz start the inexact steps cost
+    /// pressure, in plain Newton and in the continuation from it; a previous operating
+    /// point). In the continuation at M = 1000, L = 10 it took more iterations (levels 3-5:
+    /// 46, 42, 79 against 29, 31, 37) but fewer LUs: the levels cost 42, 117 and 617 s
+    /// against 58, 195 and 727 s (the run 820 s against 1,030 s), to the same films. From the Hertz start the inexact steps cost
     /// the hard scenes their convergence (spin-0.33deg: plain Newton ran out of its 30
     /// iterations at residual 5e-4, where exact Newton converges in 24, and every
     /// continuation after it failed; that run predates the tilt continuation on the
@@ -143,7 +146,8 @@ impl Attempt {
     /// - Plain Newton, with the monolithic LU reused over steps (cheapest near the solution).
     /// - A previous operating point (a sweep) on the monolithic coupling: exact Newton.
     /// - Another mesh's pressure (a coarser level): the continuation from that pressure
-    ///   (pressure-viscosity first: alpha/2, then alpha). At M = 1000, L = 10 from 0.125 a
+    ///   (pressure-viscosity first: alpha/2, then alpha), with the LU reused on the
+    ///   monolithic coupling as in plain Newton ([`Policy::reuses_lu`]). At M = 1000, L = 10 from 0.125 a
     ///   to 0.0625 a, plain Newton failed with the LU reused (18 iterations), exact (30)
     ///   and with both step safeguards off (30), and the continuation from the coarse
     ///   pressure converged in 9 + 11 + 7 iterations; the Hertz start on a fine level
@@ -161,16 +165,17 @@ impl Attempt {
             Start::Hertz => vec![Attempt::PLAIN],
             Start::Previous(_) if monolithic => vec![first, Attempt::PLAIN],
             Start::Previous(_) => vec![first],
-            Start::Pressure { plain: true, .. } => vec![first, Attempt { continues: true, ..Attempt::PLAIN }],
-            Start::Pressure { plain: false, .. } => vec![Attempt { continues: true, ..Attempt::PLAIN }],
+            Start::Pressure { plain: true, .. } => vec![first, Attempt { continues: true, ..first }],
+            Start::Pressure { plain: false, .. } => vec![Attempt { continues: true, ..first }],
         }
     }
 
     /// What the attempt is, for the log.
     pub(super) fn describe(&self) -> &'static str {
         match (self.reuse_lu, self.continues) {
-            (true, _) => "plain Newton with the LU reused over steps",
+            (true, false) => "plain Newton with the LU reused over steps",
             (false, false) => "exact plain Newton",
+            (true, true) => "the continuation with the LU reused over steps",
             (false, true) => "the continuation",
         }
     }
@@ -240,13 +245,15 @@ mod tests {
             assert_eq!(ladder[0].reuse_lu, monolithic);
             let (plain, cont) = (Policy::for_start(&coarse, ladder[0]), Policy::for_start(&coarse, ladder[1]));
             assert!(plain.plain_first && !plain.continues);
-            assert!(!cont.plain_first && cont.continues && !cont.reuses_lu);
+            assert!(!cont.plain_first && cont.continues);
+            assert_eq!(cont.reuses_lu, monolithic);
             assert_eq!((plain.line_search, cont.line_search), ("l2", "l2"));
             assert!(cont.bt_after_domain_error() && !plain.bt_after_domain_error());
         }
         // After a coarser level that needed the continuation: the continuation at once.
         let hard = Start::Pressure { p: &p, hc: 0.5, label: "level 1", plain: false, milder: None, last_resorts: true };
-        assert_eq!(Attempt::ladder(&hard, true), vec![Attempt { reuse_lu: false, continues: true }]);
+        assert_eq!(Attempt::ladder(&hard, true), vec![Attempt { reuse_lu: true, continues: true }]);
+        assert_eq!(Attempt::ladder(&hard, false), vec![Attempt { reuse_lu: false, continues: true }]);
         // A sweep's previous point: the LU reuse on the monolithic coupling, then exact Newton.
         let x = [0.0; 4];
         assert_eq!(Attempt::ladder(&Start::Previous(&x), true).len(), 2);
