@@ -75,36 +75,58 @@ impl<'a> FieldsOnFace<'a> {
 
     /// Central film, minimum film (searched on a lattice of 15 points per triangle),
     /// maximum pressure, and the load integral.
+    /// The (X, Z) of a contact triangle's vertices.
+    fn vertices(&self, tri: &[u32; 6]) -> [[f64; 2]; 3] {
+        [0, 1, 2].map(|i| {
+            let c = self.mesh.nodes[tri[i] as usize];
+            [c[0], c[2]]
+        })
+    }
+
+    /// The P2 pressure and film of a contact triangle at the 15 points of its
+    /// fourth-order lattice: (X, Z), P, H.
+    fn samples(&self, tri: &[u32; 6]) -> impl Iterator<Item = ([f64; 2], f64, f64)> {
+        const K: usize = 4;
+        let (p, h, v) = (tri.map(|n| self.p_node(n)), tri.map(|n| self.h_node(n)), self.vertices(tri));
+        (0..=K).flat_map(move |i| {
+            (0..=(K - i)).map(move |j| {
+                let b = [i as f64 / K as f64, j as f64 / K as f64, (K - i - j) as f64 / K as f64];
+                let at = [b[0] * v[0][0] + b[1] * v[1][0] + b[2] * v[2][0], b[0] * v[0][1] + b[1] * v[1][1] + b[2] * v[2][1]];
+                (at, crate::fem::p2_tri_eval(&p, b), crate::fem::p2_tri_eval(&h, b))
+            })
+        })
+    }
+
+    /// The places where the film comes within the fraction `within` of its minimum `hm`:
+    /// each contact triangle's lowest sample below (1 + within) hm, lowest first, thinned
+    /// to places at least `separation` (units of a) apart, at most `max` of them. The
+    /// first is where hm lies.
+    pub fn near_minima(&self, hm: f64, within: f64, separation: f64, max: usize) -> Vec<[f64; 2]> {
+        let lows = self.mesh.contact_tris.iter().filter_map(|tri| {
+            self.samples(tri).map(|(at, _, h)| (at, h)).filter(|&(_, h)| h < (1.0 + within) * hm).min_by(|a, b| a.1.total_cmp(&b.1))
+        });
+        separated_lowest(lows.collect(), separation, max)
+    }
+
     pub fn stats(&self) -> FilmStats {
         let (mut hm, mut hm_at) = (f64::INFINITY, [0.0; 2]);
         let (mut pmax, mut pmax_at) = (f64::NEG_INFINITY, [0.0; 2]);
         let mut pmin = f64::INFINITY;
         let mut load = 0.0;
-        const K: usize = 4;
         for tri in &self.mesh.contact_tris {
             let p = tri.map(|n| self.p_node(n));
-            let h = tri.map(|n| self.h_node(n));
-            let v = [0, 1, 2].map(|i| {
-                let c = self.mesh.nodes[tri[i] as usize];
-                [c[0], c[2]]
-            });
-            let w = p2_tri_weights(tri_area(&v));
+            let w = p2_tri_weights(tri_area(&self.vertices(tri)));
             load += (0..6).map(|k| w[k] * p[k]).sum::<f64>();
-            for i in 0..=K {
-                for j in 0..=(K - i) {
-                    let b = [i as f64 / K as f64, j as f64 / K as f64, (K - i - j) as f64 / K as f64];
-                    let (pv, hv) = (crate::fem::p2_tri_eval(&p, b), crate::fem::p2_tri_eval(&h, b));
-                    let at = [b[0] * v[0][0] + b[1] * v[1][0] + b[2] * v[2][0], b[0] * v[0][1] + b[1] * v[1][1] + b[2] * v[2][1]];
-                    if hv < hm {
-                        hm = hv;
-                        hm_at = at;
-                    }
-                    if pv > pmax {
-                        pmax = pv;
-                        pmax_at = at;
-                    }
-                    pmin = pmin.min(pv);
+            for (at, pv, hv) in self.samples(tri) {
+                if hv < hm {
+                    hm = hv;
+                    hm_at = at;
                 }
+                if pv > pmax {
+                    pmax = pv;
+                    pmax_at = at;
+                }
+                pmin = pmin.min(pv);
             }
         }
         let hc = self.at(0.0, 0.0).map(|v| v.1).unwrap_or(f64::NAN);
@@ -216,6 +238,22 @@ impl SlopeJumps {
     }
 }
 
+/// The lowest of `places` (position, value), then each next lowest at least `separation`
+/// from every one taken, at most `max` of them.
+fn separated_lowest(mut places: Vec<([f64; 2], f64)>, separation: f64, max: usize) -> Vec<[f64; 2]> {
+    places.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let mut taken: Vec<[f64; 2]> = Vec::new();
+    for (at, _) in places {
+        if taken.len() == max {
+            break;
+        }
+        if taken.iter().all(|t| (t[0] - at[0]).hypot(t[1] - at[1]) >= separation) {
+            taken.push(at);
+        }
+    }
+    taken
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -241,6 +279,40 @@ mod tests {
             }
         }
         (mesh, layout, x)
+    }
+
+    #[test]
+    fn the_near_minima_are_the_separate_dips_within_the_fraction_lowest_first() {
+        // A film with two dips, 0.5 at (1, 0) and 0.52 at (-1, 0), set through U_y.
+        let (mesh, layout, mut x) = state(|_, _| 0.0);
+        let dip = |x: f64, z: f64, cx: f64| (-((x - cx).powi(2) + z * z) / 0.1).exp();
+        let film = |x: f64, z: f64| 1.0 - 0.5 * dip(x, z, 1.0) - 0.48 * dip(x, z, -1.0);
+        x[layout.h0 as usize] = 0.0;
+        for &n in &mesh.contact_nodes {
+            let c = mesh.nodes[n as usize];
+            let d = layout.u[n as usize][1];
+            if d >= 0 {
+                x[d as usize] = Layout::gap(c) - film(c[0], c[2]);
+            }
+        }
+        let f = FieldsOnFace::new(&mesh, &layout, &x);
+        let st = f.stats();
+        assert!((st.hm - 0.5).abs() < 0.02 && (st.hm_at[0] - 1.0).abs() < 0.25, "hm {} at {:?}", st.hm, st.hm_at);
+        let near = f.near_minima(st.hm, 0.1, 0.25, 4);
+        assert_eq!(near.len(), 2, "{near:?}");
+        assert_eq!(near[0], st.hm_at);
+        assert!((near[1][0] + 1.0).abs() < 0.25 && near[1][1].abs() < 0.25, "{near:?}");
+        // Within 1 % only the lowest dip; at most one place when asked for one.
+        assert_eq!(f.near_minima(st.hm, 0.01, 0.25, 4).len(), 1);
+        assert_eq!(f.near_minima(st.hm, 0.1, 0.25, 1).len(), 1);
+    }
+
+    #[test]
+    fn separated_places_keep_their_distance_and_their_order() {
+        let places = vec![([0.0, 0.0], 3.0), ([0.1, 0.0], 1.0), ([1.0, 0.0], 2.0), ([0.05, 0.0], 0.5)];
+        assert_eq!(separated_lowest(places.clone(), 0.25, 4), vec![[0.05, 0.0], [1.0, 0.0]]);
+        assert_eq!(separated_lowest(places.clone(), 0.01, 4), vec![[0.05, 0.0], [0.1, 0.0], [1.0, 0.0], [0.0, 0.0]]);
+        assert_eq!(separated_lowest(places, 0.01, 2).len(), 2);
     }
 
     #[test]

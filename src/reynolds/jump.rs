@@ -164,6 +164,41 @@ impl JumpRows {
     }
 }
 
+impl EdgeJump {
+    /// The edge's bilinear form without gamma_E, int_E [dP/dn] [dZ/dn] ds, for nodal
+    /// values `p`, `z` indexed by node number.
+    pub fn form(&self, p: &[f64], z: &[f64]) -> f64 {
+        let d = self.nodes.len();
+        let (pe, ze): (Vec<f64>, Vec<f64>) = self.nodes.iter().map(|&n| (p[n as usize], z[n as usize])).unzip();
+        (0..d).map(|i| ze[i] * (0..d).map(|j| self.m[i * d + j] * pe[j]).sum::<f64>()).sum()
+    }
+}
+
+/// Each triangle's share of the term s(P, Z) = sum_E gamma_E int_E [dP/dn] [dZ/dn] ds:
+/// half of |gamma_E form_E(P, Z)| for each of its interior edges. `edges`: (triangle A,
+/// triangle B, the edge, gamma_E); `p`, `z` nodal values indexed by node number.
+///
+/// With Z the adjoint of a value J, this is the part of J's discretisation error the term
+/// makes: the term breaks Galerkin orthogonality, so J(u) - J(u_h) holds, besides the
+/// residual weighted by the adjoint's interpolation error, -s(P_h, Z_h). A term that
+/// moves a film value shows there, and refining where it does shrinks gamma_E.
+pub fn triangle_shares(edges: &[(usize, usize, EdgeJump, f64)], n_tris: usize, p: &[f64], z: &[f64]) -> Vec<f64> {
+    let mut share = vec![0.0; n_tris];
+    for (a, b, e, gamma) in edges {
+        let s = 0.5 * (gamma * e.form(p, z)).abs();
+        share[*a] += s;
+        share[*b] += s;
+    }
+    share
+}
+
+/// z . S(P) = sum_E gamma_E form_E(P, Z): with Z the adjoint of a value J, the first-order
+/// change of J if the term were removed (a residual perturbation r moves J by -z . r, and
+/// removing the term is r = -S(P)).
+pub fn first_order_effect(edges: &[(usize, usize, EdgeJump, f64)], p: &[f64], z: &[f64]) -> f64 {
+    edges.iter().map(|(_, _, e, gamma)| gamma * e.form(p, z)).sum()
+}
+
 /// The interior edges of a triangulation given by its P2 node lists and vertex
 /// coordinates: (triangle A, triangle B, the two shared vertex nodes), A < B. Edges with a
 /// single triangle (the boundary, the symmetry plane of a half domain) have no jump.
@@ -244,6 +279,48 @@ mod tests {
         let r0: f64 = (1..9).map(|a| t.residual_row(a, &q) * q[a]).sum();
         let full: f64 = (0..9).map(|a| (0..9).map(|b| t.edge.m[a * 9 + b] * q[b]).sum::<f64>() * q[a]).sum();
         assert!((r0 - full).abs() < 1e-12, "{r0} vs {full}");
+    }
+
+    #[test]
+    fn the_shares_vanish_for_a_smooth_pressure_and_split_a_kink_between_its_triangles() {
+        let (a, b) = square();
+        let (na, nb) = ([0, 1, 2, 10, 11, 12], [0, 2, 3, 12, 13, 14]);
+        let e = EdgeJump::new(&na, &a, &nb, &b, [0, 2]);
+        let node_xy = |n: usize| -> [f64; 2] {
+            let (k, t) = if let Some(k) = na.iter().position(|&m| m == n as u32) {
+                (k, &a)
+            } else {
+                (nb.iter().position(|&m| m == n as u32).unwrap(), &b)
+            };
+            P2Triangle::new(t).nodes()[k]
+        };
+        let field = |f: &dyn Fn(f64, f64) -> f64| -> Vec<f64> {
+            (0..15)
+                .map(|n| {
+                    if [0, 1, 2, 3, 10, 11, 12, 13, 14].contains(&n) {
+                        let x = node_xy(n);
+                        f(x[0], x[1])
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        };
+        let edges = vec![(0, 1, e, 2.0)];
+        let z = field(&|x, z| (x - z).abs());
+        // A quadratic pressure: no slope jump, no share whatever the adjoint.
+        let q = field(&|x, z| 1.0 + x * x - 0.5 * x * z);
+        assert!(triangle_shares(&edges, 2, &q, &z).iter().all(|s| s.abs() < 1e-12));
+        // The kink |x - z| / sqrt 2 against itself: gamma times the energy 4 sqrt 2, halved.
+        let k = field(&|x, z| (x - z).abs() / 2f64.sqrt());
+        let s = triangle_shares(&edges, 2, &k, &k);
+        let each = 0.5 * 2.0 * 4.0 * 2f64.sqrt();
+        assert!((s[0] - each).abs() < 1e-12 && (s[1] - each).abs() < 1e-12, "{s:?}");
+        // The signed effect: the two shares with their sign, and zero for the quadratic.
+        assert!((first_order_effect(&edges, &k, &k) - 2.0 * each).abs() < 1e-12);
+        let minus: Vec<f64> = k.iter().map(|v| -v).collect();
+        assert!((first_order_effect(&edges, &k, &minus) + 2.0 * each).abs() < 1e-12);
+        assert!(first_order_effect(&edges, &q, &z).abs() < 1e-12);
     }
 
     #[test]
