@@ -10,12 +10,13 @@ use super::Context;
 use crate::case::Scene;
 use crate::ehl::driver::{self, Adjoint};
 use crate::ehl::post::{FieldsOnFace, FilmStats};
+use crate::ehl::system::jump_terms_of;
 use crate::error::Error;
 use crate::mesh::size_field::SizeField;
 use crate::mesh::spec::dyadic_size;
 use crate::mesh::Mesh;
 use crate::reynolds::estimate::{dorfler_mark, element_residual};
-use crate::reynolds::jump::{first_order_effect, interior_edges, jump_coefficient, triangle_shares, EdgeJump};
+use crate::reynolds::jump::{edge_terms, jump_coefficient, triangle_shares, EdgeJump};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -135,18 +136,14 @@ const NEAR_MINIMUM_SEPARATION: f64 = 0.25;
 /// level's LU).
 const NEAR_MINIMUM_PLACES: usize = 4;
 
-/// The interior contact edges with their gradient-jump coefficient gamma_E (none when the
-/// scene's `reynolds.gradient_jump` is 0).
+/// The interior contact edges with their gradient-jump coefficient gamma_E, as the system
+/// assembles them (none when the scene's `reynolds.gradient_jump` is 0).
 fn jump_edges(scene: &Scene, mesh: &Mesh) -> Vec<(usize, usize, EdgeJump, f64)> {
     let c_j = scene.reynolds.gradient_jump;
-    if c_j <= 0.0 {
-        return Vec::new();
-    }
     let vel = driver::velocity_field(scene);
-    interior_edges(&mesh.contact_tris)
+    jump_terms_of(mesh, c_j, |_| true)
         .into_iter()
-        .map(|(a, b, e)| {
-            let edge = EdgeJump::new(&mesh.contact_tris[a], &mesh.contact_tri_xz(a), &mesh.contact_tris[b], &mesh.contact_tri_xz(b), e);
+        .map(|(a, b, edge)| {
             let gamma = jump_coefficient(c_j, edge.h_e, vel(edge.mid[0], edge.mid[1]));
             (a, b, edge, gamma)
         })
@@ -202,22 +199,24 @@ pub(super) fn goal_mark(
     let p: Vec<f64> = (0..mesh.nodes.len()).map(|n| fields.p_node(n as u32)).collect();
     let n = mesh.contact_tris.len();
     let (mut eta, mut from_jumps) = (vec![0.0; n], 0.0);
-    if !jumps.is_empty() {
-        // What the term does to hc and hm (at hm's place): its first-order effect through
-        // their adjoints. Logged, not yet part of the estimate (docs/accuracy.md, "Open").
-        let effect = |g: &(&str, Vec<f64>, f64)| 100.0 * first_order_effect(&jumps, &p, &g.1) / g.2;
-        ctx.log(format!(
-            "accuracy: without the gradient-jump term hc would move by {:+.2} % and hm by {:+.2} % (first order, from their adjoints)",
-            effect(&goals[0]),
-            effect(&goals[1])
-        ));
-    }
+    // The term's first-order effect on each value, relative to it (%).
+    let mut effects = Vec::with_capacity(goals.len());
     for (_, z, v) in &goals {
-        let shares = if jumps.is_empty() { vec![0.0; n] } else { triangle_shares(&jumps, n, &p, z) };
+        let terms = edge_terms(&jumps, &p, z);
+        effects.push(100.0 * terms.iter().sum::<f64>() / v);
+        let shares = triangle_shares(&jumps, n, &terms);
         for (t, tri) in mesh.contact_tris.iter().enumerate() {
             eta[t] += (rho[t] * surplus(z, tri) + shares[t]) / v.abs();
             from_jumps += shares[t] / v.abs();
         }
+    }
+    if !jumps.is_empty() {
+        // What the term does to hc and hm (at hm's place), through their adjoints. Logged,
+        // not yet part of the estimate (docs/accuracy.md, "Open").
+        ctx.log(format!(
+            "accuracy: without the gradient-jump term hc would move by {:+.2} % and hm by {:+.2} % (first order, from their adjoints)",
+            effects[0], effects[1]
+        ));
     }
     let marked = dorfler_mark(&eta, &eligible(edges), theta);
     let places = goals.iter().filter(|g| g.0 == "hm").count();

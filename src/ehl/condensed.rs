@@ -262,7 +262,7 @@ impl<'a> CondensedSystem<'a> {
         let c_j = params.stabilisation.jump;
         let jumps = super::system::jump_terms_of(mesh, c_j, |_| true)
             .into_iter()
-            .map(|edge| {
+            .map(|(_, _, edge)| {
                 let rows = edge.nodes.iter().map(|&n| layout.p_index[n as usize]).collect();
                 JumpRows::new(edge, rows, c_j, &*params.velocity)
             })

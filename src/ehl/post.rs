@@ -73,21 +73,12 @@ impl<'a> FieldsOnFace<'a> {
         Some(self.mesh.contact_tris[t].iter().zip(phi).map(|(&n, w)| (n, w)).collect())
     }
 
-    /// Central film, minimum film (searched on a lattice of 15 points per triangle),
-    /// maximum pressure, and the load integral.
-    /// The (X, Z) of a contact triangle's vertices.
-    fn vertices(&self, tri: &[u32; 6]) -> [[f64; 2]; 3] {
-        [0, 1, 2].map(|i| {
-            let c = self.mesh.nodes[tri[i] as usize];
-            [c[0], c[2]]
-        })
-    }
-
-    /// The P2 pressure and film of a contact triangle at the 15 points of its
+    /// The P2 pressure and film of contact triangle `k` at the 15 points of its
     /// fourth-order lattice: (X, Z), P, H.
-    fn samples(&self, tri: &[u32; 6]) -> impl Iterator<Item = ([f64; 2], f64, f64)> {
+    fn samples(&self, k: usize) -> impl Iterator<Item = ([f64; 2], f64, f64)> {
         const K: usize = 4;
-        let (p, h, v) = (tri.map(|n| self.p_node(n)), tri.map(|n| self.h_node(n)), self.vertices(tri));
+        let tri = &self.mesh.contact_tris[k];
+        let (p, h, v) = (tri.map(|n| self.p_node(n)), tri.map(|n| self.h_node(n)), self.mesh.contact_tri_xz(k));
         (0..=K).flat_map(move |i| {
             (0..=(K - i)).map(move |j| {
                 let b = [i as f64 / K as f64, j as f64 / K as f64, (K - i - j) as f64 / K as f64];
@@ -102,22 +93,24 @@ impl<'a> FieldsOnFace<'a> {
     /// to places at least `separation` (units of a) apart, at most `max` of them. The
     /// first is where hm lies.
     pub fn near_minima(&self, hm: f64, within: f64, separation: f64, max: usize) -> Vec<[f64; 2]> {
-        let lows = self.mesh.contact_tris.iter().filter_map(|tri| {
-            self.samples(tri).map(|(at, _, h)| (at, h)).filter(|&(_, h)| h < (1.0 + within) * hm).min_by(|a, b| a.1.total_cmp(&b.1))
+        let lows = (0..self.mesh.contact_tris.len()).filter_map(|k| {
+            self.samples(k).map(|(at, _, h)| (at, h)).filter(|&(_, h)| h < (1.0 + within) * hm).min_by(|a, b| a.1.total_cmp(&b.1))
         });
         separated_lowest(lows.collect(), separation, max)
     }
 
+    /// Central film, minimum film (searched on a lattice of 15 points per triangle),
+    /// maximum pressure, and the load integral.
     pub fn stats(&self) -> FilmStats {
         let (mut hm, mut hm_at) = (f64::INFINITY, [0.0; 2]);
         let (mut pmax, mut pmax_at) = (f64::NEG_INFINITY, [0.0; 2]);
         let mut pmin = f64::INFINITY;
         let mut load = 0.0;
-        for tri in &self.mesh.contact_tris {
+        for (k, tri) in self.mesh.contact_tris.iter().enumerate() {
             let p = tri.map(|n| self.p_node(n));
-            let w = p2_tri_weights(tri_area(&self.vertices(tri)));
-            load += (0..6).map(|k| w[k] * p[k]).sum::<f64>();
-            for (at, pv, hv) in self.samples(tri) {
+            let w = p2_tri_weights(tri_area(&self.mesh.contact_tri_xz(k)));
+            load += (0..6).map(|i| w[i] * p[i]).sum::<f64>();
+            for (at, pv, hv) in self.samples(k) {
                 if hv < hm {
                     hm = hv;
                     hm_at = at;

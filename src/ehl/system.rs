@@ -92,15 +92,17 @@ struct ContactElement {
 }
 
 /// The gradient-jump terms of the contact edges whose first triangle passes `mine`, with
-/// the coefficient `c_j` (none when it is 0).
-pub(crate) fn jump_terms_of(mesh: &Mesh, c_j: f64, mine: impl Fn(usize) -> bool) -> Vec<EdgeJump> {
+/// the coefficient `c_j` (none when it is 0): (triangle A, triangle B, the edge's term).
+pub(crate) fn jump_terms_of(mesh: &Mesh, c_j: f64, mine: impl Fn(usize) -> bool) -> Vec<(usize, usize, EdgeJump)> {
     if c_j <= 0.0 {
         return Vec::new();
     }
     interior_edges(&mesh.contact_tris)
         .into_iter()
         .filter(|&(a, _, _)| mine(a))
-        .map(|(a, b, e)| EdgeJump::new(&mesh.contact_tris[a], &mesh.contact_tri_xz(a), &mesh.contact_tris[b], &mesh.contact_tri_xz(b), e))
+        .map(|(a, b, e)| {
+            (a, b, EdgeJump::new(&mesh.contact_tris[a], &mesh.contact_tri_xz(a), &mesh.contact_tris[b], &mesh.contact_tri_xz(b), e))
+        })
         .collect()
 }
 
@@ -169,7 +171,7 @@ impl<'a> EhlSystem<'a> {
         let c_j = params.stabilisation.jump;
         let jumps = jump_terms_of(mesh, c_j, |a| part.tet_rank[mesh.contact_tri_tet[a] as usize] as usize == rank)
             .into_iter()
-            .map(|edge| {
+            .map(|(_, _, edge)| {
                 let rows = edge.nodes.iter().map(|&n| layout.p[n as usize]).collect();
                 JumpRows::new(edge, rows, c_j, &*params.velocity)
             })

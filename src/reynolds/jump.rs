@@ -174,29 +174,31 @@ impl EdgeJump {
     }
 }
 
-/// Each triangle's share of the term s(P, Z) = sum_E gamma_E int_E [dP/dn] [dZ/dn] ds:
-/// half of |gamma_E form_E(P, Z)| for each of its interior edges. `edges`: (triangle A,
-/// triangle B, the edge, gamma_E); `p`, `z` nodal values indexed by node number.
+/// Each edge's term gamma_E form_E(P, Z) of s(P, Z) = sum_E gamma_E int_E [dP/dn] [dZ/dn] ds.
+/// `edges`: (triangle A, triangle B, the edge, gamma_E); `p`, `z` nodal values indexed by
+/// node number.
+///
+/// With Z the adjoint of a value J, the sum z . S(P) is the first-order change of J if the
+/// term were removed (a residual perturbation r moves J by -z . r, and removing the term is
+/// r = -S(P)).
+pub fn edge_terms(edges: &[(usize, usize, EdgeJump, f64)], p: &[f64], z: &[f64]) -> Vec<f64> {
+    edges.iter().map(|(_, _, e, gamma)| gamma * e.form(p, z)).collect()
+}
+
+/// Each triangle's share of s(P, Z): half of |`terms`| ([`edge_terms`]) of each of its
+/// interior edges.
 ///
 /// With Z the adjoint of a value J, this is the part of J's discretisation error the term
 /// makes: the term breaks Galerkin orthogonality, so J(u) - J(u_h) holds, besides the
 /// residual weighted by the adjoint's interpolation error, -s(P_h, Z_h). A term that
 /// moves a film value shows there, and refining where it does shrinks gamma_E.
-pub fn triangle_shares(edges: &[(usize, usize, EdgeJump, f64)], n_tris: usize, p: &[f64], z: &[f64]) -> Vec<f64> {
+pub fn triangle_shares(edges: &[(usize, usize, EdgeJump, f64)], n_tris: usize, terms: &[f64]) -> Vec<f64> {
     let mut share = vec![0.0; n_tris];
-    for (a, b, e, gamma) in edges {
-        let s = 0.5 * (gamma * e.form(p, z)).abs();
-        share[*a] += s;
-        share[*b] += s;
+    for ((a, b, _, _), t) in edges.iter().zip(terms) {
+        share[*a] += 0.5 * t.abs();
+        share[*b] += 0.5 * t.abs();
     }
     share
-}
-
-/// z . S(P) = sum_E gamma_E form_E(P, Z): with Z the adjoint of a value J, the first-order
-/// change of J if the term were removed (a residual perturbation r moves J by -z . r, and
-/// removing the term is r = -S(P)).
-pub fn first_order_effect(edges: &[(usize, usize, EdgeJump, f64)], p: &[f64], z: &[f64]) -> f64 {
-    edges.iter().map(|(_, _, e, gamma)| gamma * e.form(p, z)).sum()
 }
 
 /// The interior edges of a triangulation given by its P2 node lists and vertex
@@ -310,17 +312,19 @@ mod tests {
         let z = field(&|x, z| (x - z).abs());
         // A quadratic pressure: no slope jump, no share whatever the adjoint.
         let q = field(&|x, z| 1.0 + x * x - 0.5 * x * z);
-        assert!(triangle_shares(&edges, 2, &q, &z).iter().all(|s| s.abs() < 1e-12));
+        let shares = |p: &[f64], z: &[f64]| triangle_shares(&edges, 2, &edge_terms(&edges, p, z));
+        let effect = |p: &[f64], z: &[f64]| edge_terms(&edges, p, z).iter().sum::<f64>();
+        assert!(shares(&q, &z).iter().all(|s| s.abs() < 1e-12));
         // The kink |x - z| / sqrt 2 against itself: gamma times the energy 4 sqrt 2, halved.
         let k = field(&|x, z| (x - z).abs() / 2f64.sqrt());
-        let s = triangle_shares(&edges, 2, &k, &k);
+        let s = shares(&k, &k);
         let each = 0.5 * 2.0 * 4.0 * 2f64.sqrt();
         assert!((s[0] - each).abs() < 1e-12 && (s[1] - each).abs() < 1e-12, "{s:?}");
         // The signed effect: the two shares with their sign, and zero for the quadratic.
-        assert!((first_order_effect(&edges, &k, &k) - 2.0 * each).abs() < 1e-12);
+        assert!((effect(&k, &k) - 2.0 * each).abs() < 1e-12);
         let minus: Vec<f64> = k.iter().map(|v| -v).collect();
-        assert!((first_order_effect(&edges, &k, &minus) + 2.0 * each).abs() < 1e-12);
-        assert!(first_order_effect(&edges, &q, &z).abs() < 1e-12);
+        assert!((effect(&k, &minus) + 2.0 * each).abs() < 1e-12);
+        assert!(effect(&q, &z).abs() < 1e-12);
     }
 
     #[test]
