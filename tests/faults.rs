@@ -40,7 +40,10 @@ fn interrupt_run(name: &str, wait_for: &str, sig: i32, target: Target) -> (Optio
     let stdout = child.stdout.take().unwrap();
     let mut seen = false;
     let t0 = Instant::now();
-    for line in BufReader::new(stdout).lines() {
+    // The reader stays open until mpirun exits: a pipe closed early would kill mpirun with
+    // SIGPIPE when the ranks print another line before the signal reaches them.
+    let mut lines = BufReader::new(stdout).lines();
+    for line in lines.by_ref() {
         let line = line.unwrap();
         if line.contains(wait_for) {
             seen = true;
@@ -64,6 +67,7 @@ fn interrupt_run(name: &str, wait_for: &str, sig: i32, target: Target) -> (Optio
     for p in pids {
         unsafe { libc::kill(p, sig) };
     }
+    lines.for_each(drop);
     let output = child.wait_with_output().unwrap();
     (output.status.code(), String::from_utf8_lossy(&output.stderr).into_owned(), out)
 }

@@ -396,7 +396,10 @@ fn signal_at(args: &[String], out: &Path, wait_for: &str, sig: i32) -> (Option<i
     let timeout_pid = child.id();
     let mut log = String::new();
     let mut seen = false;
-    for line in BufReader::new(child.stdout.take().unwrap()).lines() {
+    // The reader stays open until mpirun exits: a pipe closed early would kill mpirun with
+    // SIGPIPE when the ranks print another line before the signal reaches them.
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    for line in lines.by_ref() {
         let line = line.unwrap();
         log.push_str(&line);
         log.push('\n');
@@ -413,6 +416,10 @@ fn signal_at(args: &[String], out: &Path, wait_for: &str, sig: i32) -> (Option<i
         for p in ranks {
             unsafe { libc::kill(p, sig) };
         }
+    }
+    for line in lines {
+        log.push_str(&line.unwrap_or_default());
+        log.push('\n');
     }
     let output = child.wait_with_output().unwrap();
     log.push_str(&String::from_utf8_lossy(&output.stdout));
