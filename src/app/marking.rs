@@ -150,6 +150,13 @@ fn jump_edges(scene: &Scene, mesh: &Mesh) -> Vec<(usize, usize, EdgeJump, f64)> 
         .collect()
 }
 
+/// A goal-oriented marking: the marked triangles, and the weighted indicator summed over
+/// the triangles for each value (hc, hm at each of its places, fx, fz), relative to it.
+pub(super) struct Marking {
+    pub marked: Vec<bool>,
+    pub sums: Vec<(&'static str, f64)>,
+}
+
 /// Goal-oriented marking: each triangle's mass-flux indicator weighted by how much a flux
 /// error there moves each target value (its adjoint's hierarchical P2 surplus over the
 /// triangle's edges: the part of the adjoint the triangle's P1 interpolant misses),
@@ -167,11 +174,11 @@ pub(super) fn goal_mark(
     friction: Option<[f64; 2]>,
     edges: &[f64],
     theta: f64,
-) -> Result<Vec<bool>, Error> {
+) -> Result<Marking, Error> {
     let t0 = Instant::now();
     let mesh = fields.mesh;
     // (name, the adjoint's pressure part, the value's scale)
-    let mut goals: Vec<(&str, Vec<f64>, f64)> = Vec::new();
+    let mut goals: Vec<(&'static str, Vec<f64>, f64)> = Vec::new();
     goals.push(("hc", adjoint.pressure_part(&adjoint.film(ctx, &film_weights(fields, [0.0, 0.0])?)?), st.hc));
     // hm is a minimum: every place where the film comes near it is a goal of its own, or the
     // next level refines only the present minimum and the minimum moves to a place left
@@ -201,14 +208,19 @@ pub(super) fn goal_mark(
     let (mut eta, mut from_jumps) = (vec![0.0; n], 0.0);
     // The term's first-order effect on each value, relative to it (%).
     let mut effects = Vec::with_capacity(goals.len());
-    for (_, z, v) in &goals {
+    let mut sums = Vec::with_capacity(goals.len());
+    for (name, z, v) in &goals {
         let terms = edge_terms(&jumps, &p, z);
         effects.push(100.0 * terms.iter().sum::<f64>() / v);
         let shares = triangle_shares(&jumps, n, &terms);
+        let mut sum = 0.0;
         for (t, tri) in mesh.contact_tris.iter().enumerate() {
-            eta[t] += (rho[t] * surplus(z, tri) + shares[t]) / v.abs();
+            let share = (rho[t] * surplus(z, tri) + shares[t]) / v.abs();
+            eta[t] += share;
+            sum += share;
             from_jumps += shares[t] / v.abs();
         }
+        sums.push((*name, sum));
     }
     if !jumps.is_empty() {
         // What the term does to hc and hm (at hm's place), through their adjoints. Logged,
@@ -224,6 +236,10 @@ pub(super) fn goal_mark(
     let mut names: Vec<&str> = goals.iter().map(|g| g.0).collect();
     names.dedup();
     ctx.log(format!(
+        "accuracy: weighted indicator per value (relative; a bound-like sum, not the estimate): {}",
+        sums.iter().map(|(name, s)| format!("{name} {:.3e}", s)).collect::<Vec<_>>().join(", ")
+    ));
+    ctx.log(format!(
         "accuracy: goal-oriented marking ({}{}): {} of {} contact triangles marked (fraction {theta} of the weighted indicator{}), {:.1} s",
         names.join(", "),
         if places > 1 { format!("; hm at {places} places") } else { String::new() },
@@ -236,7 +252,7 @@ pub(super) fn goal_mark(
         },
         t0.elapsed().as_secs_f64()
     ));
-    Ok(marked)
+    Ok(Marking { marked, sums })
 }
 
 /// The P2 interpolation weights of the film at `p` (units of a) on the contact face.
