@@ -21,7 +21,7 @@
 //!    last level's result is written with its estimated error, `accuracy.reached` is
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
 use super::lubricated::{post_point, Setup};
-use super::marking::{goal_mark, longest_edges, next_field, within_radius, zone_mark};
+use super::marking::{goal_mark, goals, longest_edges, next_field, within_radius, zone_mark};
 use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
 use crate::case::Scene;
@@ -437,20 +437,21 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             Some(match adjoint.as_ref().filter(|_| goal) {
                 // A failed adjoint costs this level's goal-oriented marking, not the run (an
                 // interruption is acted on at the check after the marking).
-                Some(Ok(a)) => match collective::agree(
-                    &ctx.world,
-                    goal_mark(ctx, scene, a, &fields, &st, levels.last().and_then(|l| l.friction), &edges, acc.marking),
-                ) {
-                    Ok(m) => {
-                        zone_retry = Some(k + 1);
-                        levels.last_mut().expect("the level just pushed").indicator = m.sums;
-                        m.marked
+                Some(Ok(a)) => {
+                    match collective::agree(&ctx.world, goals(ctx, scene, a, &fields, &st, levels.last().and_then(|l| l.friction)))
+                        .map(|goals| goal_mark(ctx, scene, &fields, &goals, &edges, acc.marking))
+                    {
+                        Ok(m) => {
+                            zone_retry = Some(k + 1);
+                            levels.last_mut().expect("the level just pushed").indicator = m.sums;
+                            m.marked
+                        }
+                        Err(e) => {
+                            ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
+                            zone_mark(&fields, &edges)
+                        }
                     }
-                    Err(e) => {
-                        ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
-                        zone_mark(&fields, &edges)
-                    }
-                },
+                }
                 Some(Err(e)) => {
                     ctx.log(format!("accuracy: the adjoint failed ({e}); level {} refines the pressurised zone", k + 1));
                     zone_mark(&fields, &edges)

@@ -157,46 +157,56 @@ pub(super) struct Marking {
     pub sums: Vec<(&'static str, f64)>,
 }
 
-/// Goal-oriented marking: each triangle's mass-flux indicator weighted by how much a flux
-/// error there moves each target value (its adjoint's hierarchical P2 surplus over the
-/// triangle's edges: the part of the adjoint the triangle's P1 interpolant misses),
-/// relative to that value, summed over the values, plus the gradient-jump term's share of
-/// each value's error ([`triangle_shares`]); Doerfler marking at `theta`. The values
-/// are hc, hm and, with friction (`friction`: this level's fx, fz), fx and fz, each relative
-/// to the friction coefficient's magnitude as in the estimate (fz vanishes without spin).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn goal_mark(
+/// A value the marking serves: its name, the pressure part of its adjoint and its scale
+/// (the film for hc and hm, the friction coefficient's magnitude for fx and fz).
+pub(super) struct Goal {
+    name: &'static str,
+    z: Vec<f64>,
+    scale: f64,
+}
+
+/// The goals of a converged level, each with its adjoint from the level's LU: hc, hm at
+/// each place where the film comes near it, and, with friction (`friction`: this level's
+/// fx, fz), fx and fz, each relative to the friction coefficient's magnitude as in the
+/// estimate (fz vanishes without spin, and on a half domain it is no goal).
+pub(super) fn goals(
     ctx: &Context,
     scene: &Scene,
     adjoint: &Adjoint,
     fields: &FieldsOnFace,
     st: &FilmStats,
     friction: Option<[f64; 2]>,
-    edges: &[f64],
-    theta: f64,
-) -> Result<Marking, Error> {
-    let t0 = Instant::now();
-    let mesh = fields.mesh;
-    // (name, the adjoint's pressure part, the value's scale)
-    let mut goals: Vec<(&'static str, Vec<f64>, f64)> = Vec::new();
-    goals.push(("hc", adjoint.pressure_part(&adjoint.film(ctx, &film_weights(fields, [0.0, 0.0])?)?), st.hc));
+) -> Result<Vec<Goal>, Error> {
+    let film = |at: [f64; 2]| -> Result<Vec<f64>, Error> { Ok(adjoint.pressure_part(&adjoint.film(ctx, &film_weights(fields, at)?)?)) };
+    let mut goals = vec![Goal { name: "hc", z: film([0.0, 0.0])?, scale: st.hc }];
     // hm is a minimum: every place where the film comes near it is a goal of its own, or the
     // next level refines only the present minimum and the minimum moves to a place left
     // coarse (docs/accuracy.md, "What a level refines").
     for at in fields.near_minima(st.hm, NEAR_MINIMUM, NEAR_MINIMUM_SEPARATION, NEAR_MINIMUM_PLACES) {
-        goals.push(("hm", adjoint.pressure_part(&adjoint.film(ctx, &film_weights(fields, at)?)?), st.hm));
+        goals.push(Goal { name: "hm", z: film(at)?, scale: st.hm });
     }
     if let Some(f) = friction {
-        let setup = super::lubricated::friction_setup(scene, mesh.spec.contact).expect("a scene with friction");
+        let setup = super::lubricated::friction_setup(scene, fields.mesh.spec.contact).expect("a scene with friction");
         let grad = crate::friction::pass::friction_gradient(fields, &setup)?;
         let magnitude = f[0].hypot(f[1]);
         // On a half domain fz vanishes by symmetry, and so does its gradient.
         for (name, c) in [("fx", 0), ("fz", 1)].into_iter().take(if fields.half() { 1 } else { 2 }) {
             let dh: Vec<(u32, f64)> = grad.nodes.iter().map(|(n, g)| (*n, g[2 * c + 1])).collect();
             let dp: Vec<(u32, f64)> = grad.nodes.iter().map(|(n, g)| (*n, g[2 * c])).collect();
-            goals.push((name, adjoint.pressure_part(&adjoint.functional(ctx, &dh, &dp)?), magnitude));
+            goals.push(Goal { name, z: adjoint.pressure_part(&adjoint.functional(ctx, &dh, &dp)?), scale: magnitude });
         }
     }
+    Ok(goals)
+}
+
+/// Goal-oriented marking: each triangle's mass-flux indicator weighted by how much a flux
+/// error there moves each goal's value (its adjoint's hierarchical P2 surplus over the
+/// triangle's edges: the part of the adjoint the triangle's P1 interpolant misses),
+/// relative to that value, summed over the goals ([`goals`]), plus the gradient-jump
+/// term's share of each value's error ([`triangle_shares`]); Doerfler marking at `theta`.
+pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goals: &[Goal], edges: &[f64], theta: f64) -> Marking {
+    let t0 = Instant::now();
+    let mesh = fields.mesh;
     let rho = indicators(scene, fields);
     let surplus = |z: &[f64], tri: &[u32; 6]| {
         (0..3).map(|e| (z[tri[3 + e] as usize] - 0.5 * (z[tri[e] as usize] + z[tri[(e + 1) % 3] as usize])).abs()).fold(0.0, f64::max)
@@ -209,7 +219,7 @@ pub(super) fn goal_mark(
     // The term's first-order effect on each value, relative to it (%).
     let mut effects = Vec::with_capacity(goals.len());
     let mut sums = Vec::with_capacity(goals.len());
-    for (name, z, v) in &goals {
+    for Goal { name, z, scale: v } in goals {
         let terms = edge_terms(&jumps, &p, z);
         effects.push(100.0 * terms.iter().sum::<f64>() / v);
         let shares = triangle_shares(&jumps, n, &terms);
@@ -231,9 +241,9 @@ pub(super) fn goal_mark(
         ));
     }
     let marked = dorfler_mark(&eta, &eligible(edges), theta);
-    let places = goals.iter().filter(|g| g.0 == "hm").count();
+    let places = goals.iter().filter(|g| g.name == "hm").count();
     // The hm places are consecutive goals: one name.
-    let mut names: Vec<&str> = goals.iter().map(|g| g.0).collect();
+    let mut names: Vec<&str> = goals.iter().map(|g| g.name).collect();
     names.dedup();
     ctx.log(format!(
         "accuracy: weighted indicator per value (relative; a bound-like sum, not the estimate): {}",
@@ -252,7 +262,7 @@ pub(super) fn goal_mark(
         },
         t0.elapsed().as_secs_f64()
     ));
-    Ok(Marking { marked, sums })
+    Marking { marked, sums }
 }
 
 /// The P2 interpolation weights of the film at `p` (units of a) on the contact face.
