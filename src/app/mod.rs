@@ -3,6 +3,7 @@
 pub mod adapt;
 pub mod cli;
 pub mod dry;
+mod face_files;
 pub mod lubricated;
 mod marking;
 pub mod plots;
