@@ -72,10 +72,6 @@ pub struct Level {
     pub friction: Option<[f64; 2]>,
     /// Estimated errors (None on level 0).
     pub est: Option<Estimate>,
-    /// The goal-oriented marking's weighted indicator summed per value, relative to it (hm
-    /// once per place; empty when the level marked nothing by goals). Reported, not used
-    /// to stop: its effectivity is measured in docs/accuracy.md.
-    pub indicator: Vec<(&'static str, f64)>,
 }
 
 /// The estimated relative errors of a level's target quantities: hc and hm, and with
@@ -399,7 +395,6 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             pmax: st.pmax * ph,
             friction: level_friction(scene, &fields)?,
             est: None,
-            indicator: Vec::new(),
         };
         levels.push(level);
         if k == 0 && acc.max_seconds > 0.0 {
@@ -446,8 +441,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     {
                         Ok(m) => {
                             zone_retry = Some(k + 1);
-                            levels.last_mut().expect("the level just pushed").indicator = m.sums;
-                            m.marked
+                            m
                         }
                         Err(e) => {
                             ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
@@ -594,15 +588,6 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
                 v["fx"] = json!(fx);
                 v["fz"] = json!(fz);
             }
-            if !l.indicator.is_empty() {
-                // hm has one sum per place, hm's own place first.
-                let hm: Vec<f64> = l.indicator.iter().filter(|g| g.0 == "hm").map(|g| g.1).collect();
-                let mut w = json!({ "hm": hm });
-                for (name, sum) in l.indicator.iter().filter(|g| g.0 != "hm") {
-                    w[*name] = json!(sum);
-                }
-                v["weighted_indicator"] = w;
-            }
             v
         }).collect::<Vec<_>>(),
     });
@@ -675,7 +660,6 @@ mod tests {
             pmax: 1.0,
             friction: f,
             est: None,
-            indicator: Vec::new(),
         };
         // fz is zero up to round-off (no spin): its change is measured against |f|, not |fz|.
         let levels = [level(1.0, Some([0.03, 1e-12])), level(1.0, Some([0.0303, 3e-12]))];

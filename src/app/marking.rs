@@ -150,13 +150,6 @@ fn jump_edges(scene: &Scene, mesh: &Mesh) -> Vec<(usize, usize, EdgeJump, f64)> 
         .collect()
 }
 
-/// A goal-oriented marking: the marked triangles, and the weighted indicator summed over
-/// the triangles for each value (hc, hm at each of its places, fx, fz), relative to it.
-pub(super) struct Marking {
-    pub marked: Vec<bool>,
-    pub sums: Vec<(&'static str, f64)>,
-}
-
 /// A value the marking serves: its name, the pressure part of its adjoint and its scale
 /// (the film for hc and hm, the friction coefficient's magnitude for fx and fz).
 pub(super) struct Goal {
@@ -204,7 +197,7 @@ pub(super) fn goals(
 /// triangle's edges: the part of the adjoint the triangle's P1 interpolant misses),
 /// relative to that value, summed over the goals ([`goals`]), plus the gradient-jump
 /// term's share of each value's error ([`triangle_shares`]); Doerfler marking at `theta`.
-pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goals: &[Goal], edges: &[f64], theta: f64) -> Marking {
+pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goals: &[Goal], edges: &[f64], theta: f64) -> Vec<bool> {
     let t0 = Instant::now();
     let mesh = fields.mesh;
     let rho = indicators(scene, fields);
@@ -218,19 +211,14 @@ pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goa
     let (mut eta, mut from_jumps) = (vec![0.0; n], 0.0);
     // The term's first-order effect on each value, relative to it (%).
     let mut effects = Vec::with_capacity(goals.len());
-    let mut sums = Vec::with_capacity(goals.len());
-    for Goal { name, z, scale: v } in goals {
+    for Goal { z, scale: v, .. } in goals {
         let terms = edge_terms(&jumps, &p, z);
         effects.push(100.0 * terms.iter().sum::<f64>() / v);
         let shares = triangle_shares(&jumps, n, &terms);
-        let mut sum = 0.0;
         for (t, tri) in mesh.contact_tris.iter().enumerate() {
-            let share = (rho[t] * surplus(z, tri) + shares[t]) / v.abs();
-            eta[t] += share;
-            sum += share;
+            eta[t] += (rho[t] * surplus(z, tri) + shares[t]) / v.abs();
             from_jumps += shares[t] / v.abs();
         }
-        sums.push((*name, sum));
     }
     if !jumps.is_empty() {
         // What the term does to hc and hm (at hm's place), through their adjoints. Logged,
@@ -246,10 +234,6 @@ pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goa
     let mut names: Vec<&str> = goals.iter().map(|g| g.name).collect();
     names.dedup();
     ctx.log(format!(
-        "accuracy: weighted indicator per value (relative; a bound-like sum, not the estimate): {}",
-        sums.iter().map(|(name, s)| format!("{name} {:.3e}", s)).collect::<Vec<_>>().join(", ")
-    ));
-    ctx.log(format!(
         "accuracy: goal-oriented marking ({}{}): {} of {} contact triangles marked (fraction {theta} of the weighted indicator{}), {:.1} s",
         names.join(", "),
         if places > 1 { format!("; hm at {places} places") } else { String::new() },
@@ -262,7 +246,7 @@ pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goa
         },
         t0.elapsed().as_secs_f64()
     ));
-    Marking { marked, sums }
+    marked
 }
 
 /// The P2 interpolation weights of the film at `p` (units of a) on the contact face.
