@@ -40,8 +40,8 @@ fn interrupt_run(name: &str, wait_for: &str, sig: i32, target: Target) -> (Optio
     let stdout = child.stdout.take().unwrap();
     let mut seen = false;
     let t0 = Instant::now();
-    // The reader stays open until mpirun exits: a pipe closed early would kill mpirun with
-    // SIGPIPE when the ranks print another line before the signal reaches them.
+    // The reader stays open until mpirun exits: mpirun aborts itself with SIGPIPE after ten
+    // writes to a closed pipe, which the ranks may print before the signal reaches them.
     let mut lines = BufReader::new(stdout).lines();
     for line in lines.by_ref() {
         let line = line.unwrap();

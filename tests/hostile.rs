@@ -396,8 +396,8 @@ fn signal_at(args: &[String], out: &Path, wait_for: &str, sig: i32) -> (Option<i
     let timeout_pid = child.id();
     let mut log = String::new();
     let mut seen = false;
-    // The reader stays open until mpirun exits: a pipe closed early would kill mpirun with
-    // SIGPIPE when the ranks print another line before the signal reaches them.
+    // The reader stays open until mpirun exits: mpirun aborts itself with SIGPIPE after ten
+    // writes to a closed pipe, which the ranks may print before the signal reaches them.
     let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
     for line in lines.by_ref() {
         let line = line.unwrap();

@@ -163,10 +163,7 @@ fn estimate_scaled(q: &[f64], scale: f64) -> Option<f64> {
             RHO_CAP
         };
         let rho = if rho.is_finite() { rho.min(RHO_CAP) } else { RHO_CAP };
-        e *= (rho / (1.0 - rho)).max(1.0);
-    }
-    if k >= 1 {
-        e = e.max(FASTEST_CONTRACTION * d[k - 1]);
+        e = (e * (rho / (1.0 - rho)).max(1.0)).max(FASTEST_CONTRACTION * d[k - 1]);
     }
     Some(e / scale)
 }

@@ -5,6 +5,8 @@ use crate::error::Error;
 use crate::friction::pass::FrictionResult;
 use std::path::Path;
 
+/// A centre-line profile as CSV: x, z, p, h (and the disc's shear stresses with friction)
+/// in SI units, one row per sample.
 pub(super) fn write_profiles(dir: &Path, name: &str, rows: &[Vec<f64>], with_tau: bool) -> Result<(), Error> {
     let mut text = String::from(if with_tau { "x_m,z_m,p_pa,h_m,tau_yx_pa,tau_yz_pa\n" } else { "x_m,z_m,p_pa,h_m\n" });
     for r in rows {
@@ -54,7 +56,8 @@ pub(super) fn write_plots(
     }
     // The film grows to tens of um at the rectangle's corners: colours and the profile's
     // film axis stop at 4 hc so the contact's film shape stays visible.
-    let h_top = 4.0 * fields.stats().hc * hs * 1e6;
+    let hc_um = fields.stats().hc * hs * 1e6;
+    let h_top = 4.0 * hc_um;
     let opts = |label: &str, range: Option<(f64, f64)>| MapOpts {
         circle: Some((0.0, 0.0, 1.0)),
         colorbar_label: label.to_string(),
@@ -70,11 +73,7 @@ pub(super) fn write_plots(
     }
     // The contact itself: |x|, |z| <= 1.3 a, colours up to 1.5 hc, so the side lobes, the
     // outlet constriction and the minimum film stand out.
-    let zoom = MapOpts {
-        x_range: Some((-1.3, 1.3)),
-        y_range: Some((-1.3, 1.3)),
-        ..opts("h (um)", Some((0.0, 1.5 * fields.stats().hc * hs * 1e6)))
-    };
+    let zoom = MapOpts { x_range: Some((-1.3, 1.3)), y_range: Some((-1.3, 1.3)), ..opts("h (um)", Some((0.0, 1.5 * hc_um))) };
     // The face mesh the film was solved on (an adaptive run's last level) over the film.
     let mut edges: Vec<[[f64; 2]; 2]> = Vec::new();
     let mut seen = std::collections::HashSet::new();

@@ -222,7 +222,7 @@ pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goa
     }
     if !jumps.is_empty() {
         // What the term does to hc and hm (at hm's place), through their adjoints. Logged,
-        // not yet part of the estimate (docs/accuracy.md, "Open").
+        // not part of the estimate (docs/accuracy.md, "A change small by chance after level 0").
         ctx.log(format!(
             "accuracy: without the gradient-jump term hc would move by {:+.2} % and hm by {:+.2} % (first order, from their adjoints)",
             effects[0], effects[1]
