@@ -38,3 +38,14 @@ pub fn sum_f64(world: &SimpleCommunicator, v: f64) -> f64 {
     world.all_reduce_into(&v, &mut out, SystemOperation::sum());
     out
 }
+
+/// Rank 0's values on every rank (the length too): for data every rank computed from the
+/// same global state, which a mesh or a marking built on each rank must see bit for bit.
+pub fn from_rank0(world: &SimpleCommunicator, local: &[f64]) -> Vec<f64> {
+    let root = world.process_at_rank(0);
+    let mut n = local.len() as u64;
+    root.broadcast_into(&mut n);
+    let mut out = if world.rank() == 0 { local.to_vec() } else { vec![0.0; n as usize] };
+    root.broadcast_into(&mut out[..]);
+    out
+}

@@ -87,8 +87,14 @@ pub(super) fn longest_edges(mesh: &Mesh) -> Vec<f64> {
 /// theirs (a triangle of a Kuhn cell of size h has its longest edge h sqrt 2, or h one
 /// bisection further; both halve to h/2 and keep h). `edges`: [`longest_edges`].
 pub(super) fn next_field(mesh: &Mesh, edges: &[f64], marked: &[bool], growth: f64) -> SizeField {
-    let sizes: Vec<f64> =
-        edges.iter().zip(marked).map(|(&e, &m)| if m { dyadic_size(0.5 * e).max(MIN_ADAPTIVE_SIZE) } else { dyadic_size(e) }).collect();
+    let sizes: Vec<f64> = edges.iter().zip(marked).map(|(&e, &m)| if m { 0.5 * e } else { e }).collect();
+    field_of_sizes(mesh, &sizes, growth)
+}
+
+/// The size field with every contact triangle at the dyadic size of `sizes[t]` (units of a,
+/// not below [`MIN_ADAPTIVE_SIZE`]).
+pub(super) fn field_of_sizes(mesh: &Mesh, sizes: &[f64], growth: f64) -> SizeField {
+    let sizes: Vec<f64> = sizes.iter().map(|&e| dyadic_size(e).max(MIN_ADAPTIVE_SIZE)).collect();
     let smallest = sizes.iter().cloned().fold(f64::INFINITY, f64::min);
     let mut f = SizeField::new(mesh.spec.contact, 0.5 * smallest, growth, mesh.spec.contact_size);
     for (k, &size) in sizes.iter().enumerate() {
@@ -105,6 +111,18 @@ pub(super) fn within_radius(mesh: &Mesh, radius: f64) -> Vec<bool> {
         .map(|t| {
             let p = mesh.contact_tri_xz(t);
             ((p[0][0] + p[1][0] + p[2][0]) / 3.0).hypot((p[0][1] + p[1][1] + p[2][1]) / 3.0) <= radius
+        })
+        .collect()
+}
+
+/// The contact triangles that reach into one of the annuli `bands` (radius, half width;
+/// units of a): some vertex inside it, or vertices on both sides of it.
+pub(super) fn within_bands(mesh: &Mesh, bands: &[(f64, f64)]) -> Vec<bool> {
+    (0..mesh.contact_tris.len())
+        .map(|t| {
+            let r = mesh.contact_tri_xz(t).map(|p| p[0].hypot(p[1]));
+            let (lo, hi) = (r.iter().cloned().fold(f64::INFINITY, f64::min), r.iter().cloned().fold(0.0, f64::max));
+            bands.iter().any(|&(rc, w)| lo <= rc + w && hi >= rc - w)
         })
         .collect()
 }
@@ -252,4 +270,53 @@ pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goa
 /// The P2 interpolation weights of the film at `p` (units of a) on the contact face.
 pub(super) fn film_weights(fields: &FieldsOnFace, p: [f64; 2]) -> Result<Vec<(u32, f64)>, Error> {
     fields.weights_at(p[0], p[1]).ok_or_else(|| Error::numerical(format!("accuracy: ({}, {}) is not on the contact face", p[0], p[1])))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::spec::MeshSpec;
+
+    #[test]
+    fn a_band_around_a_radius_is_refined_twice_and_nothing_else_moves() {
+        // The default half-domain face at 0.25 a; an annulus of half width 0.1 a around
+        // r = 0.95 a quartered, as a first level retried after its film closed there.
+        let mut spec = MeshSpec::paper_default();
+        spec.half_z = true;
+        spec.contact = crate::mesh::spec::Rect { x0: -3.0, x1: 3.0, z0: -3.0, z1: 0.0 };
+        let mesh = crate::mesh::generate(&spec).unwrap();
+        let edges = longest_edges(&mesh);
+        let band = within_bands(&mesh, &[(0.95, 0.1)]);
+        let centroid_r = |m: &Mesh, t: usize| {
+            let p = m.contact_tri_xz(t);
+            ((p[0][0] + p[1][0] + p[2][0]) / 3.0).hypot((p[0][1] + p[1][1] + p[2][1]) / 3.0)
+        };
+        // Every triangle whose centroid is in the annulus is marked; none beyond one
+        // element (0.25 sqrt 2) of it.
+        for (t, &marked) in band.iter().enumerate() {
+            let r = centroid_r(&mesh, t);
+            if (r - 0.95).abs() <= 0.1 {
+                assert!(marked, "triangle {t} at r = {r} not marked");
+            }
+            if (r - 0.95).abs() > 0.1 + 0.36 {
+                assert!(!marked, "triangle {t} at r = {r} marked");
+            }
+        }
+        let sizes: Vec<f64> = band.iter().zip(&edges).map(|(&b, &e)| if b { 0.25 * e } else { e }).collect();
+        spec.size_field = Some(std::sync::Arc::new(field_of_sizes(&mesh, &sizes, 1.0)));
+        let finer = crate::mesh::generate(&spec).unwrap();
+        let fine_edges = longest_edges(&finer);
+        for (t, &edge) in fine_edges.iter().enumerate() {
+            let r = centroid_r(&finer, t);
+            // In the annulus: a quarter of 0.25 a (longest edge h or h sqrt 2).
+            if (r - 0.95).abs() <= 0.1 {
+                assert!(edge <= 0.0625 * 2f64.sqrt() * 1.001, "r = {r}: edge {edge}");
+            }
+            // Far from it (beyond the grading): the face as it was.
+            if (r - 0.95).abs() > 1.0 && r < 2.5 {
+                assert!(edge >= 0.25 * 0.999, "r = {r}: edge {edge}");
+            }
+        }
+        assert!(finer.contact_tris.len() > mesh.contact_tris.len());
+    }
 }

@@ -46,6 +46,11 @@ pub enum Error {
     /// Newton (or a series of solves: a sweep, a convergence study) did not converge.
     #[error("{0}")]
     NotConverged(String),
+    /// Newton did not converge, and on the way its iterates closed the film (H <= 0) at
+    /// `closed` (X, Z in units of a, in the order met): where the mesh was too coarse for
+    /// the film, or where the model has none (a spin pole; the message says which).
+    #[error("{message}")]
+    FilmClosed { message: String, closed: Vec<[f64; 2]> },
     /// A solve ended with a state that cannot be used (NaN, infinities, an unphysical film)
     /// or a numerical step failed.
     #[error("{0}")]

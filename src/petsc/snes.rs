@@ -55,13 +55,22 @@ pub struct SolveReport {
     pub iterations: usize,
     pub linear_iterations: usize,
     pub residual_norm: f64,
+    /// The residual norm at the start (before the first step).
+    pub initial_residual_norm: f64,
     pub domain_error: Option<String>,
 }
 
 /// A PETSc SNES (Newton with line search by default; everything overridable by options).
 pub struct Snes {
     raw: ffi::SNES,
+    /// The residual norms of the last solve (PETSc writes them here while it solves), and
+    /// their linear iteration counts.
+    history: Vec<ffi::PetscReal>,
+    history_its: Vec<ffi::PetscInt>,
 }
+
+/// Residual norms kept of one solve (more than any Newton iteration budget used).
+const HISTORY: usize = 1000;
 
 unsafe extern "C" fn form_function(snes: ffi::SNES, x: ffi::Vec, f: ffi::Vec, ctx: *mut c_void) -> ffi::PetscErrorCode {
     let ctx = &mut *(ctx as *mut Context);
@@ -163,7 +172,15 @@ impl Snes {
     pub fn new(comm: ffi::MPI_Comm, prefix: &str) -> Result<Snes> {
         let mut raw: ffi::SNES = std::ptr::null_mut();
         pcall!(ffi::SNESCreate(comm, &mut raw))?;
-        let s = Snes { raw };
+        let mut s = Snes { raw, history: vec![0.0; HISTORY], history_its: vec![0; HISTORY] };
+        // The buffers live as long as the SNES, which writes into them on every solve.
+        pcall!(ffi::SNESSetConvergenceHistory(
+            s.raw,
+            s.history.as_mut_ptr(),
+            s.history_its.as_mut_ptr(),
+            HISTORY as ffi::PetscInt,
+            ffi::PetscBool_PETSC_TRUE
+        ))?;
         if !prefix.is_empty() {
             let p = std::ffi::CString::new(prefix).unwrap();
             pcall!(ffi::SNESSetOptionsPrefix(s.raw, p.as_ptr()))?;
@@ -202,6 +219,10 @@ impl Snes {
         pcall!(ffi::SNESGetLinearSolveIterations(self.raw, &mut lits))?;
         let mut norm = 0.0;
         pcall!(ffi::SNESGetFunctionNorm(self.raw, &mut norm))?;
+        let (mut kept, mut kept_its, mut n_kept): (*mut ffi::PetscReal, *mut ffi::PetscInt, ffi::PetscInt) =
+            (std::ptr::null_mut(), std::ptr::null_mut(), 0);
+        pcall!(ffi::SNESGetConvergenceHistory(self.raw, &mut kept, &mut kept_its, &mut n_kept))?;
+        let initial = if n_kept > 0 { self.history[0] } else { norm };
         Ok(SolveReport {
             converged: reason > 0,
             reason: reason_name,
@@ -209,6 +230,7 @@ impl Snes {
             iterations: its as usize,
             linear_iterations: lits as usize,
             residual_norm: norm,
+            initial_residual_norm: initial,
             domain_error: ctx.domain_error.take(),
         })
     }
