@@ -29,6 +29,7 @@ use crate::collective;
 use crate::ehl::driver::{EhlSolution, EhlSolver, Milder, Start};
 use crate::ehl::post::FieldsOnFace;
 use crate::error::Error;
+use crate::error::Reached;
 use crate::mesh::size_field::SizeField;
 use crate::mesh::spec::dyadic_size;
 use serde_json::json;
@@ -260,6 +261,43 @@ fn closures(ctx: &Context, e: &Error) -> Vec<[f64; 2]> {
     collective::from_rank0(&ctx.world, &local).chunks_exact(2).map(|c| [c[0], c[1]]).collect()
 }
 
+/// The furthest state of the continuation in the failure `e`, if it got past its start,
+/// the same on every rank (each rank gathered the same state; rank 0's is taken so that a
+/// rank that failed otherwise cannot disagree). Collective.
+fn reached(ctx: &Context, e: Error) -> Option<Reached> {
+    let local = match e {
+        Error::FilmClosed { reached: Some(r), .. } => Some(*r),
+        _ => None,
+    };
+    let t = collective::from_rank0(&ctx.world, &local.as_ref().map_or(vec![], |r| vec![r.t]));
+    let x = collective::from_rank0(&ctx.world, local.as_ref().map_or(&[][..], |r| &r.x));
+    let parameter = local.map_or("", |r| r.parameter);
+    t.first().map(|&t| Reached { parameter, t, x })
+}
+
+/// The first level's solve: from the Hertz start, or, after a try whose continuation got
+/// part of the way (`furthest`: its mesh and state), on from that state. The retry solves
+/// that continuation's milder problem from the coarser state and ramps to the scene, with
+/// no plain Newton before it and no Hertz start after it: plain Newton and the
+/// pressure-viscosity search had failed from the Hertz start on every try of
+/// cases/hard/heavy-3gpa (241 s of its 141,301-unknown try), and the load continuation is
+/// the one that got anywhere.
+fn onward(ctx: &Context, scene: &Scene, solver: &EhlSolver, furthest: Option<&(Setup, Reached)>) -> Result<EhlSolution, Error> {
+    let Some((setup, r)) = furthest else {
+        return solver.solve(ctx, scene, None);
+    };
+    let f = FieldsOnFace::new(&setup.mesh, &setup.layout, &r.x);
+    let p = |x: f64, z: f64| f.at(x, z).map_or(0.0, |v| v.0);
+    let label = format!("the failed try's state ({} contact triangles)", setup.mesh.contact_tris.len());
+    let ts = [r.t];
+    let milder = Milder { parameter: r.parameter, ts: &ts, p: &p, hc: f.stats().hc, label: &label };
+    solver.solve_from(
+        ctx,
+        scene,
+        Start::Pressure { p: &p, hc: milder.hc, label: &label, plain: false, milder: Some(milder), last_resorts: false },
+    )
+}
+
 /// A solved level kept for the next one: its setup, solution, dimensionless central film
 /// and condensation time.
 struct Solved {
@@ -301,6 +339,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let mut full_ladder: Option<usize> = None;
     // Seconds of the present level's attempts that did not converge: part of its time.
     let mut tried_s = 0.0;
+    // The furthest a failed first level's continuation got, with that level's mesh: the
+    // retry goes on from there ([`onward`]).
+    let mut furthest: Option<(Setup, Reached)> = None;
     loop {
         let scene = &own;
         // The level being solved: one per converged level (a retried first level stays 0).
@@ -413,7 +454,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 }
             }
             (None, Some(e)) => e.solve(ctx, scene, &solver)?,
-            (None, None) => match collective::agree(&ctx.world, solver.solve(ctx, scene, None)) {
+            (None, None) => match collective::agree(&ctx.world, onward(ctx, scene, &solver, furthest.as_ref())) {
                 Ok(sol) => sol,
                 // A first mesh too coarse for the film (at low speed or high load the side
                 // lobes and the outlet constriction are narrower than 0.25 a, and the film
@@ -432,6 +473,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     }
                     first_retries += 1;
                     tried_s += t0.elapsed().as_secs_f64();
+                    drop(solver);
+                    if let Some(r) = reached(ctx, e).filter(|r| furthest.as_ref().map_or(true, |(_, f)| r.t > f.t)) {
+                        furthest = Some((setup, r));
+                    }
                     continue;
                 }
                 Err(e) => return Err(e),

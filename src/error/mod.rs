@@ -16,6 +16,17 @@ use std::path::{Path, PathBuf};
 /// `Result` with the project's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
+/// How far a continuation that did not reach the scene got: the continuation's name, the
+/// value of its parameter t < 1 where it last converged, and the state there (gathered, in
+/// the layout the solver reports states in). A finer mesh can go on from there instead of
+/// repeating the path from the start.
+#[derive(Debug, Clone)]
+pub struct Reached {
+    pub parameter: &'static str,
+    pub t: f64,
+    pub x: Vec<f64>,
+}
+
 /// Every failure of the library and the program.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -49,8 +60,9 @@ pub enum Error {
     /// Newton did not converge, and on the way its iterates closed the film (H <= 0) at
     /// `closed` (X, Z in units of a, in the order met): where the mesh was too coarse for
     /// the film, or where the model has none (a spin pole; the message says which).
+    /// `reached` is the furthest a continuation got on the way, if any got past its start.
     #[error("{message}")]
-    FilmClosed { message: String, closed: Vec<[f64; 2]> },
+    FilmClosed { message: String, closed: Vec<[f64; 2]>, reached: Option<Box<Reached>> },
     /// A solve ended with a state that cannot be used (NaN, infinities, an unphysical film)
     /// or a numerical step failed.
     #[error("{0}")]

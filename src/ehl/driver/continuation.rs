@@ -11,7 +11,7 @@ use super::problem::{lambda_bar, lubricant, penalty, velocity_field};
 use crate::case::Scene;
 use crate::context::Context;
 use crate::ehl::system::EhlProblem;
-use crate::error::Error;
+use crate::error::{Error, Reached};
 use crate::petsc::factor::MUMPS_WORKSPACE_PERCENT;
 use crate::petsc::snes::{Snes, SolveReport};
 use crate::petsc::{self, Matrix, Vector};
@@ -498,9 +498,17 @@ pub(super) fn newton_with_continuation(
     }
     let continued = state.is_none();
     let mut reached_from: Option<ContinuationPath> = None;
+    // The furthest a continuation that failed got (largest t), for the error.
+    let mut furthest: Option<Reached> = None;
     // 2. If it failed: the continuations, each from a milder problem back to the base one.
+    // The continuation a coarser mesh's path went through is tried first, and even when it
+    // is a last resort: that path shows it gets somewhere from this start.
     if state.is_none() && policy.continues {
-        for h in homotopies(scene).into_iter().filter(|h| policy.last_resorts || !h.parameter.last_resort()) {
+        let leads = |h: &Homotopy| milder.as_ref().is_some_and(|m| m.parameter == h.parameter.name());
+        let mut list: Vec<Homotopy> =
+            homotopies(scene).into_iter().filter(|h| policy.last_resorts || !h.parameter.last_resort() || leads(h)).collect();
+        list.sort_by_key(|h| !leads(h));
+        for h in list {
             // A kinematic parameter also needs a problem whose velocity field can change.
             if h.parameter.kinematic() && !system.set_velocity(velocity_field(scene)) {
                 continue;
@@ -527,6 +535,10 @@ pub(super) fn newton_with_continuation(
                 state = Some(xs);
                 reached_from = Some(ContinuationPath { parameter: h.parameter.name(), ts: below, x: first });
                 break;
+            }
+            let t_last = below.last().copied().unwrap_or(t);
+            if furthest.as_ref().map_or(true, |f| t_last > f.t) {
+                furthest = Some(Reached { parameter: h.parameter.name(), t: t_last, x: xs });
             }
             if h.parameter.kinematic() {
                 // Back to the scene's own velocity field for what follows.
@@ -571,7 +583,7 @@ pub(super) fn newton_with_continuation(
         );
         return Err(match nw.closed.is_empty() {
             true => Error::NotConverged(message),
-            false => Error::FilmClosed { message, closed: nw.closed },
+            false => Error::FilmClosed { message, closed: nw.closed, reached: furthest.map(Box::new) },
         });
     };
     let last = last.clone();

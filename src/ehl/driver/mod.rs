@@ -281,7 +281,7 @@ fn solve_condensed(
         (lo, hi),
         cl.local(ctx.rank),
         milder.as_ref().map(|(m, x)| MilderStart { parameter: m.parameter, ts: m.ts, x, label: m.label }),
-    )?;
+    );
     let solve_s = t1.elapsed().as_secs_f64();
     // Back to the monolithic layout for post-processing: P, H0 and U_y on the face.
     let monolithic = |xc: &[f64]| {
@@ -299,6 +299,13 @@ fn solve_condensed(
         x[layout.h0 as usize] = xc[cl.h0()];
         x
     };
+    // A failure's furthest state is reported in the monolithic layout too.
+    let out = out.map_err(|mut e| {
+        if let Error::FilmClosed { reached: Some(r), .. } = &mut e {
+            r.x = monolithic(&r.x);
+        }
+        e
+    })?;
     let x = monolithic(&out.x);
     let milder = out.milder.map(|path| ContinuationPath { x: monolithic(&path.x), ..path });
     let coupling = if comp.is_rigid() { Coupling::Rigid } else { Coupling::Condensed };
