@@ -170,7 +170,9 @@ fn estimate_scaled(q: &[f64], scale: f64) -> Option<f64> {
     Some(e / scale)
 }
 
-/// How many times a first level that does not converge is solved again on a finer mesh.
+/// How many times a first level that does not converge is solved again on a finer mesh
+/// (cases/hard/heavy-3gpa converges on the second retry: 0.25 a, then 0.0625 a and 0.03125 a
+/// annuli where the film closed).
 const FIRST_LEVEL_RETRIES: usize = 2;
 /// Radius (units of a) of the zone a retried first level halves: the Hertz circle with the
 /// outlet constriction and the side lobes (r up to about 1.1 a).
@@ -275,27 +277,40 @@ fn reached(ctx: &Context, e: Error) -> Option<Reached> {
     t.first().map(|&t| Reached { parameter, t, x })
 }
 
-/// The first level's solve: from the Hertz start, or, after a try whose continuation got
-/// part of the way (`furthest`: its mesh and state), on from that state. The retry solves
-/// that continuation's milder problem from the coarser state and ramps to the scene, with
-/// no plain Newton before it and no Hertz start after it: plain Newton and the
-/// pressure-viscosity search had failed from the Hertz start on every try of
-/// cases/hard/heavy-3gpa (241 s of its 141,301-unknown try), and the load continuation is
-/// the one that got anywhere.
-fn onward(ctx: &Context, scene: &Scene, solver: &EhlSolver, furthest: Option<&(Setup, Reached)>) -> Result<EhlSolution, Error> {
-    let Some((setup, r)) = furthest else {
-        return solver.solve(ctx, scene, None);
+/// Where a retried first level starts instead of the Hertz start.
+enum Onward {
+    /// The furthest state of the failed try's continuation, on the try's mesh.
+    Reached(Setup, Reached),
+    /// The try's converged state, whose film was not positive everywhere, on its mesh.
+    Converged(Setup, Vec<f64>),
+}
+
+/// The first level's solve: from the Hertz start, or on from an earlier try (`from`).
+/// - After a try whose continuation got part of the way: that continuation's milder
+///   problem solved from the try's state and ramped to the scene, with no plain Newton
+///   before it and no Hertz start after it. Plain Newton and the pressure-viscosity search
+///   had failed from the Hertz start on every try of cases/hard/heavy-3gpa (241 s of its
+///   141,301-unknown try), and the load continuation is the one that got anywhere.
+/// - After a try that converged to a film not positive everywhere: from that state, as a
+///   coarser level's (plain Newton, the continuation from it, then the Hertz start).
+///   cases/hard/spin-0.33deg's retry (166,728 unknowns) spent 305 s in plain Newton from
+///   the Hertz start and did not converge.
+fn onward(ctx: &Context, scene: &Scene, solver: &EhlSolver, from: Option<&Onward>) -> Result<EhlSolution, Error> {
+    let (setup, x, reached) = match from {
+        None => return solver.solve(ctx, scene, None),
+        Some(Onward::Reached(setup, r)) => (setup, &r.x, Some(r)),
+        Some(Onward::Converged(setup, x)) => (setup, x, None),
     };
-    let f = FieldsOnFace::new(&setup.mesh, &setup.layout, &r.x);
+    let f = FieldsOnFace::new(&setup.mesh, &setup.layout, x);
     let p = |x: f64, z: f64| f.at(x, z).map_or(0.0, |v| v.0);
+    let hc = f.stats().hc;
     let label = format!("the failed try's state ({} contact triangles)", setup.mesh.contact_tris.len());
+    let Some(r) = reached else {
+        return solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc, label: &label, plain: true, milder: None, last_resorts: true });
+    };
     let ts = [r.t];
-    let milder = Milder { parameter: r.parameter, ts: &ts, p: &p, hc: f.stats().hc, label: &label };
-    solver.solve_from(
-        ctx,
-        scene,
-        Start::Pressure { p: &p, hc: milder.hc, label: &label, plain: false, milder: Some(milder), last_resorts: false },
-    )
+    let milder = Milder { parameter: r.parameter, ts: &ts, p: &p, hc, label: &label };
+    solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc, label: &label, plain: false, milder: Some(milder), last_resorts: false })
 }
 
 /// A solved level kept for the next one: its setup, solution, dimensionless central film
@@ -339,9 +354,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let mut full_ladder: Option<usize> = None;
     // Seconds of the present level's attempts that did not converge: part of its time.
     let mut tried_s = 0.0;
-    // The furthest a failed first level's continuation got, with that level's mesh: the
-    // retry goes on from there ([`onward`]).
-    let mut furthest: Option<(Setup, Reached)> = None;
+    // Where a failed first level got, with its mesh: the retry goes on from there ([`onward`]).
+    let mut from: Option<Onward> = None;
     loop {
         let scene = &own;
         // The level being solved: one per converged level (a retried first level stays 0).
@@ -454,7 +468,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 }
             }
             (None, Some(e)) => e.solve(ctx, scene, &solver)?,
-            (None, None) => match collective::agree(&ctx.world, onward(ctx, scene, &solver, furthest.as_ref())) {
+            (None, None) => match collective::agree(&ctx.world, onward(ctx, scene, &solver, from.as_ref())) {
                 Ok(sol) => sol,
                 // A first mesh too coarse for the film (at low speed or high load the side
                 // lobes and the outlet constriction are narrower than 0.25 a, and the film
@@ -474,8 +488,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     first_retries += 1;
                     tried_s += t0.elapsed().as_secs_f64();
                     drop(solver);
-                    if let Some(r) = reached(ctx, e).filter(|r| furthest.as_ref().map_or(true, |(_, f)| r.t > f.t)) {
-                        furthest = Some((setup, r));
+                    let further = |r: &Reached| !matches!(&from, Some(Onward::Reached(_, f)) if f.t >= r.t);
+                    if let Some(r) = reached(ctx, e).filter(further) {
+                        from = Some(Onward::Reached(setup, r));
                     }
                     continue;
                 }
@@ -501,6 +516,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             }
             first_retries += 1;
             tried_s += t0.elapsed().as_secs_f64();
+            drop(solver);
+            from = Some(Onward::Converged(setup, sol.x));
             continue;
         }
         if unphysical {
