@@ -4,6 +4,7 @@ pub mod adapt;
 pub mod cli;
 pub mod dry;
 mod face_files;
+mod first_level;
 pub mod lubricated;
 mod marking;
 pub mod plots;
