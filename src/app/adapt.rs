@@ -29,8 +29,7 @@ use crate::case::Scene;
 use crate::collective;
 use crate::ehl::driver::{EhlSolution, EhlSolver, Milder, Start};
 use crate::ehl::post::FieldsOnFace;
-use crate::error::Error;
-use crate::error::Reached;
+use crate::error::{Error, Reached};
 use crate::mesh::size_field::SizeField;
 use serde_json::json;
 use std::sync::Arc;
@@ -346,7 +345,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     tried_s += t0.elapsed().as_secs_f64();
                     drop(solver);
                     let further = |r: &Reached| !matches!(&from, Some(Onward::Reached(_, f)) if f.t >= r.t);
-                    if let Some(r) = reached(ctx, e).filter(further) {
+                    if let Some(r) = reached(ctx, &e).filter(further) {
                         from = Some(Onward::Reached(setup, r));
                     }
                     continue;
