@@ -14,15 +14,20 @@
 //!    ratio of the last two changes (capped at 0.8): for a sequence converging by a factor
 //!    rho per level the remaining error is rho/(1 - rho) times the last change. A change
 //!    below 1/8 of the one before it is a crossing of the limit, not convergence (see
-//!    [`estimate`]). Stop when every estimate is below the target (from level 2 on, so
+//!    `estimate::estimate_scaled`). Stop when every estimate is below the target (from level 2 on, so
 //!    that rho is measured).
-//! 5. When the target cannot be reached (`accuracy.max_levels` levels solved, the next
-//!    level above `accuracy.max_unknowns`, or every triangle at the smallest size), the
+//! 5. A next level above `accuracy.max_unknowns` refines only the marked triangles of
+//!    largest indicator that fit (`marking::cut_count`), once per run; its
+//!    estimate is the one before it less its change (`estimate_after_cut`).
+//! 6. When the target cannot be reached (`accuracy.max_levels` levels solved, the next
+//!    level above `accuracy.max_unknowns` with too little room for a cut, or every
+//!    triangle at the smallest size), the
 //!    last level's result is written with its estimated error, `accuracy.reached` is
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
+use super::estimate::Estimate;
 use super::first_level::{closures, first_level_again, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, Setup};
-use super::marking::{goal_mark, goals, longest_edges, next_field, zone_mark};
+use super::marking::{cut_count, goal_mark, goals, longest_edges, next_field, zone_mark, Marking, MIN_BUDGET_SHARE};
 use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
 use crate::case::Scene;
@@ -38,15 +43,9 @@ use std::time::Instant;
 /// Smallest element size adaptive refinement makes (units of a): 16/2^12.
 pub const MIN_ADAPTIVE_SIZE: f64 = 16.0 / 4096.0;
 
-/// The ratio of successive changes is capped here: beyond it the sequence is not
-/// converging in a way an estimate can trust, and the factor rho/(1 - rho) stays at 4.
-const RHO_CAP: f64 = 0.8;
-
-/// The smallest ratio of successive changes a converging level sequence can show: a
-/// P2 discretisation converges at most at third order in the element size (hc and hm:
-/// observed orders 1.2-3.5, docs/accuracy.md), 2^-3 per halving. A smaller ratio is a
-/// change that crossed the limit by chance.
-const FASTEST_CONTRACTION: f64 = 0.125;
+/// Meshes tried for a level cut to the budget (each a fraction of a second at 600,000
+/// unknowns): a cut that still exceeds it is cut again from there ([`cut_count`]).
+const MAX_CUTS: usize = 6;
 
 /// One level of the adaptive loop.
 #[derive(Debug, Clone)]
@@ -73,100 +72,9 @@ pub struct Level {
     pub friction: Option<[f64; 2]>,
     /// Estimated errors (None on level 0).
     pub est: Option<Estimate>,
-}
-
-/// The estimated relative errors of a level's target quantities: hc and hm, and with
-/// friction fx and fz, each relative to the magnitude of the friction coefficient
-/// sqrt(fx^2 + fz^2) (fz vanishes by symmetry without spin, so its own size is no scale).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Estimate {
-    pub hc: f64,
-    pub hm: f64,
-    pub friction: Option<[f64; 2]>,
-}
-
-impl Estimate {
-    /// The estimate of the last level of `levels`, None before the second level.
-    fn of(levels: &[Level]) -> Option<Estimate> {
-        let series = |f: &dyn Fn(&Level) -> f64| levels.iter().map(f).collect::<Vec<f64>>();
-        let hc = estimate(&series(&|l| l.hc))?;
-        let hm = estimate(&series(&|l| l.hm))?;
-        let friction = levels.iter().map(|l| l.friction).collect::<Option<Vec<[f64; 2]>>>().and_then(|f| {
-            let last = f.last()?;
-            let scale = last[0].hypot(last[1]);
-            let fx: Vec<f64> = f.iter().map(|v| v[0]).collect();
-            let fz: Vec<f64> = f.iter().map(|v| v[1]).collect();
-            Some([estimate_scaled(&fx, scale)?, estimate_scaled(&fz, scale)?])
-        });
-        Some(Estimate { hc, hm, friction })
-    }
-
-    /// Every estimated error.
-    fn values(&self) -> Vec<f64> {
-        let mut v = vec![self.hc, self.hm];
-        v.extend(self.friction.iter().flatten());
-        v
-    }
-
-    /// "hc x %, hm y %" (and fx, fz).
-    fn describe(&self) -> String {
-        let mut s = format!("hc {:.2} %, hm {:.2} %", 100.0 * self.hc, 100.0 * self.hm);
-        if let Some([fx, fz]) = self.friction {
-            s.push_str(&format!(", fx {:.2} %, fz {:.2} %", 100.0 * fx, 100.0 * fz));
-        }
-        s
-    }
-
-    fn json(&self) -> serde_json::Value {
-        let mut v = json!({ "hc": self.hc, "hm": self.hm });
-        if let Some([fx, fz]) = self.friction {
-            v["fx"] = json!(fx);
-            v["fz"] = json!(fz);
-        }
-        v
-    }
-}
-
-/// The estimated relative error of the last value of `q` (see the module documentation).
-pub fn estimate(q: &[f64]) -> Option<f64> {
-    estimate_scaled(q, q.last()?.abs())
-}
-
-/// The estimated error of the last value of `q` relative to `scale`.
-///
-/// With changes d_i = q_i - q_{i-1}, the last one d_k and rho = |d_k / d_{k-1}|:
-/// e = max(1, rho/(1 - rho)) |d_k|. Two guards make a coincidence visible:
-/// - a change smaller than [`FASTEST_CONTRACTION`] times the one before it is faster than
-///   the discretisation converges; it is a crossing of the limit, not convergence. So the
-///   estimate is at least [`FASTEST_CONTRACTION`] |d_{k-1}| (the next change of a
-///   sequence converging at that rate). The change from the first level counts too: a
-///   large one says the first level was far off, and the next change can be small by
-///   chance (cases/hard/slow without the gradient-jump term: a side lobe narrower than
-///   the elements held hm within 0.66 % over one halving and moved it by 4.1 % over the
-///   next);
-/// - the ratio after such a crossing is measured over two changes, rho = sqrt|d_k / d_{k-2}|,
-///   not against the crossing.
-fn estimate_scaled(q: &[f64], scale: f64) -> Option<f64> {
-    let n = q.len();
-    if n < 2 {
-        return None;
-    }
-    let d: Vec<f64> = q.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
-    let k = d.len() - 1;
-    let crossing = |i: usize| i >= 1 && d[i] < FASTEST_CONTRACTION * d[i - 1];
-    let mut e = d[k];
-    if k >= 1 {
-        let rho = if crossing(k - 1) {
-            (d[k] / d[k - 2]).sqrt()
-        } else if d[k - 1] > 0.0 {
-            d[k] / d[k - 1]
-        } else {
-            RHO_CAP
-        };
-        let rho = if rho.is_finite() { rho.min(RHO_CAP) } else { RHO_CAP };
-        e = (e * (rho / (1.0 - rho)).max(1.0)).max(FASTEST_CONTRACTION * d[k - 1]);
-    }
-    Some(e / scale)
+    /// The share of its marked triangles' indicator the level refined when all of them would
+    /// have exceeded `accuracy.max_unknowns` (None: all of them).
+    pub budget_share: Option<f64>,
 }
 
 /// A solved level kept for the next one: its setup, solution, dimensionless central film
@@ -180,6 +88,8 @@ struct Solved {
     exponents: Option<serde_json::Value>,
     /// The gradient-jump factor the level was solved with (it may be raised after it).
     gradient_jump: f64,
+    /// The marking of the next level (None on the last).
+    marking: Option<Marking>,
 }
 
 /// Runs the adaptive loop of a lubricated single-point scene with `accuracy.target > 0`.
@@ -212,6 +122,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let mut tried_s = 0.0;
     // Where a failed first level got, with its mesh: the retry goes on from there ([`onward`]).
     let mut from: Option<Onward> = None;
+    // How many of its marked triangles the present level refines when all of them would
+    // exceed the budget, with the share of the indicator they carry, and how often it was cut.
+    let (mut cut, mut cuts): (Option<(usize, f64)>, usize) = (None, 0);
     loop {
         let scene = &own;
         // The level being solved: one per converged level (a retried first level stays 0).
@@ -223,6 +136,25 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         };
         let (n_u, n_p) = setup.layout.counts();
         if let (Some(prev), true) = (&previous, (n_u + n_p + 1) as u64 > acc.max_unknowns) {
+            // The level is cut to the budget: the marked triangles of largest indicator that
+            // fit, once per run (a second cut would carry an estimate carried over already).
+            let before = levels.last().map_or(0, |l| (l.elastic_unknowns + l.pressure_unknowns + 1) as u64);
+            let once = !levels.iter().any(|l| l.budget_share.is_some()) && cuts < MAX_CUTS;
+            if let Some((m, marked)) = prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| once) {
+                let count = cut_count(before, (cut.map_or(marked, |c| c.0), (n_u + n_p + 1) as u64), acc.max_unknowns);
+                let share = m.indicator_share(count);
+                if share >= MIN_BUDGET_SHARE {
+                    ctx.log(format!(
+                        "accuracy: level {k} would have {} unknowns, above accuracy.max_unknowns = {}; it refines the {count} of the {marked} marked triangles with the largest indicator instead ({:.0} % of their indicator)",
+                        n_u + n_p + 1,
+                        acc.max_unknowns,
+                        100.0 * share
+                    ));
+                    field = Some(Arc::new(next_field(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), &m.largest(count), growth)));
+                    (cut, cuts) = (Some((count, share)), cuts + 1);
+                    continue;
+                }
+            }
             let why = format!("level {k} would have {} unknowns, above accuracy.max_unknowns = {}", n_u + n_p + 1, acc.max_unknowns);
             let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
             return finish(ctx, scene, prev, target, &levels, Some(why));
@@ -401,7 +333,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             pmax: st.pmax * ph,
             friction: level_friction(scene, &fields)?,
             est: None,
+            budget_share: cut.take().map(|c| c.1),
         };
+        cuts = 0;
         levels.push(level);
         if k == 0 && acc.max_seconds > 0.0 {
             // The budget covers the levels after the first: a run always has a result.
@@ -411,9 +345,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let level = levels.last_mut().expect("the level just pushed");
         level.est = est;
         ctx.log(format!(
-            "accuracy: level {k}: {} contact triangles (smallest {:.4} a), {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}; estimated error {}",
+            "accuracy: level {k}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}; estimated error {}",
             level.contact_triangles,
             level.min_size,
+            level.budget_share.map_or(String::new(), |s| format!(" (cut to the budget: {:.0} % of the marked indicator)", 100.0 * s)),
             n_u + n_p + 1,
             level.newton_iterations,
             level.seconds,
@@ -451,15 +386,15 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         }
                         Err(e) => {
                             ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
-                            zone_mark(&fields, &edges)
+                            Marking::unranked(zone_mark(&fields, &edges))
                         }
                     }
                 }
                 Some(Err(e)) => {
                     ctx.log(format!("accuracy: the adjoint failed ({e}); level {} refines the pressurised zone", k + 1));
-                    zone_mark(&fields, &edges)
+                    Marking::unranked(zone_mark(&fields, &edges))
                 }
-                None => zone_mark(&fields, &edges),
+                None => Marking::unranked(zone_mark(&fields, &edges)),
             })
         } else {
             None
@@ -471,7 +406,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let condensation_s = solver.condensation_s;
         drop(fields);
         drop(solver);
-        let here = Solved { setup, sol, hc: st.hc, condensation_s, exponents, gradient_jump: scene.reynolds.gradient_jump };
+        let here =
+            Solved { setup, sol, hc: st.hc, condensation_s, exponents, gradient_jump: scene.reynolds.gradient_jump, marking: marked };
         if reached {
             ctx.log(format!("accuracy: target {target} reached at level {k}"));
             return finish(ctx, scene, &here, target, &levels, None);
@@ -480,12 +416,12 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             let why = short_of(target, &format!("accuracy.max_levels = {max_levels} refinement levels solved"), k, est);
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
-        let marked = marked.expect("marked when the loop goes on");
+        let marked = &here.marking.as_ref().expect("marked when the loop goes on").marked;
         if !marked.iter().any(|&m| m) {
             let why = short_of(target, &format!("every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"), k, est);
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
-        field = Some(Arc::new(next_field(&here.setup.mesh, &edges, &marked, growth)));
+        field = Some(Arc::new(next_field(&here.setup.mesh, &edges, marked, growth)));
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
             return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
         }
@@ -581,7 +517,7 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
     let mut report = json!({
         "target": target,
         "reached": shortfall.is_none(),
-        "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it), and at least 1/8 of the change before the last",
+        "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it), and at least 1/8 of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change",
         "levels": levels.iter().enumerate().map(|(k, l)| {
             let mut v = json!({
                 "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
@@ -597,6 +533,9 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
                 v["fx"] = json!(fx);
                 v["fz"] = json!(fz);
             }
+            if let Some(share) = l.budget_share {
+                v["budget_share"] = json!(share);
+            }
             v
         }).collect::<Vec<_>>(),
     });
@@ -607,79 +546,4 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
         report["not_reached_because"] = json!(why);
     }
     report
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_estimate_of_a_geometric_sequence_bounds_its_error() {
-        // q_k = 1 + 0.1 rho^k converges to 1; the estimate of the last value's relative
-        // error is rho/(1-rho) times the last change: exact for a geometric sequence.
-        for rho in [0.25, 0.5, 0.7] {
-            let q: Vec<f64> = (0..5).map(|k| 1.0 + 0.1 * f64::powi(rho, k)).collect();
-            let e = estimate(&q).unwrap();
-            let true_err = (q[4] - 1.0) / q[4];
-            let factor = (rho / (1.0 - rho)).max(1.0);
-            assert!((e - factor * (q[4] - q[3]).abs() / q[4]).abs() < 1e-15);
-            assert!(e >= true_err * (1.0 - 1e-12), "rho {rho}: estimate {e} below the error {true_err}");
-        }
-        assert_eq!(estimate(&[1.0]), None);
-        // Two values: the change itself.
-        assert!((estimate(&[1.0, 1.01]).unwrap() - 0.01 / 1.01).abs() < 1e-15);
-    }
-
-    #[test]
-    fn a_change_that_crosses_the_limit_by_chance_is_not_trusted() {
-        // hm of table2-ue2 with only a target (um, levels 0-4 at 0.25 a down to 0.0156 a):
-        // the third change (+0.22 %) is a crossing; level 4 shows hm was still 0.96 % off.
-        let hm = [0.145152, 0.152788, 0.136198, 0.136493, 0.137811];
-        let error_of_level_3 = (hm[4] - hm[3]) / hm[4];
-        let e3 = estimate(&hm[..4]).unwrap();
-        assert!(e3 >= error_of_level_3, "level 3: estimate {e3} below the error {error_of_level_3}");
-        assert!((e3 - 0.125 * (hm[2] - hm[1]).abs() / hm[3]).abs() < 1e-15, "{e3}");
-        // After the crossing the ratio is taken over two changes (sqrt(0.97/10.9) = 0.3):
-        // the estimate is the last change itself, not 4 times it.
-        let e4 = estimate(&hm).unwrap();
-        assert!((e4 - (hm[4] - hm[3]).abs() / hm[4]).abs() < 1e-15, "{e4}");
-        // cases/hard/slow: after level 0's one-node dip of hm the next change is held to an
-        // eighth of it too; the level after it decides.
-        let hm = [2.34073e-9, 1.02892e-8, 1.01946e-8];
-        let e = estimate(&hm).unwrap();
-        assert!((e - 0.125 * (hm[1] - hm[0]).abs() / hm[2]).abs() < 1e-15, "{e}");
-        // A sequence converging at third order keeps its plain estimate.
-        let q: Vec<f64> = (0..5).map(|k| 1.0 + 0.1 * f64::powi(0.125, k)).collect();
-        assert!((estimate(&q).unwrap() - (q[4] - q[3]).abs() / q[4]).abs() < 1e-15);
-    }
-
-    #[test]
-    fn friction_errors_are_relative_to_the_friction_coefficient_and_join_the_targets() {
-        let level = |hc: f64, f: Option<[f64; 2]>| Level {
-            elastic_unknowns: 0,
-            pressure_unknowns: 0,
-            contact_triangles: 0,
-            min_size: 0.25,
-            newton_iterations: 0,
-            seconds: 0.0,
-            failed_seconds: 0.0,
-            hc,
-            hm: 1.0,
-            hm_at: [0.0, -0.9],
-            pmax: 1.0,
-            friction: f,
-            est: None,
-        };
-        // fz is zero up to round-off (no spin): its change is measured against |f|, not |fz|.
-        let levels = [level(1.0, Some([0.03, 1e-12])), level(1.0, Some([0.0303, 3e-12]))];
-        let e = Estimate::of(&levels).unwrap();
-        let [fx, fz] = e.friction.unwrap();
-        assert!((fx - 0.0003 / 0.0303).abs() < 1e-12 && fz < 1e-9, "{e:?}");
-        assert_eq!(e.values().len(), 4);
-        assert!(e.describe().contains("fx 0.99 %"), "{}", e.describe());
-        // Without friction only hc and hm.
-        let e = Estimate::of(&[level(1.0, None), level(1.02, None)]).unwrap();
-        assert_eq!((e.values().len(), e.friction), (2, None));
-        assert!(Estimate::of(&[level(1.0, None)]).is_none());
-    }
 }

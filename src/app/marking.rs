@@ -215,7 +215,7 @@ pub(super) fn goals(
 /// triangle's edges: the part of the adjoint the triangle's P1 interpolant misses),
 /// relative to that value, summed over the goals ([`goals`]), plus the gradient-jump
 /// term's share of each value's error ([`triangle_shares`]); Doerfler marking at `theta`.
-pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goals: &[Goal], edges: &[f64], theta: f64) -> Vec<bool> {
+pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goals: &[Goal], edges: &[f64], theta: f64) -> Marking {
     let t0 = Instant::now();
     let mesh = fields.mesh;
     let rho = indicators(scene, fields);
@@ -247,6 +247,8 @@ pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goa
         ));
     }
     let marked = dorfler_mark(&eta, &eligible(edges), theta);
+    let mut ranked: Vec<(usize, f64)> = (0..n).filter(|&t| marked[t]).map(|t| (t, eta[t])).collect();
+    ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
     let places = goals.iter().filter(|g| g.name == "hm").count();
     // The hm places are consecutive goals: one name.
     let mut names: Vec<&str> = goals.iter().map(|g| g.name).collect();
@@ -264,7 +266,72 @@ pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goa
         },
         t0.elapsed().as_secs_f64()
     ));
-    marked
+    Marking { marked, ranked: Some(ranked) }
+}
+
+/// The triangles a level marks for the next one, and, when the marking ranks them
+/// (goal-oriented), the marked ones by decreasing indicator with their indicator: the next
+/// level can then be cut to its budget ([`cut_count`]).
+pub(super) struct Marking {
+    pub marked: Vec<bool>,
+    pub ranked: Option<Vec<(usize, f64)>>,
+}
+
+impl Marking {
+    /// A marking with no ranking (zone marking).
+    pub fn unranked(marked: Vec<bool>) -> Marking {
+        Marking { marked, ranked: None }
+    }
+
+    /// The `count` marked triangles of largest indicator, as flags (all of them without a
+    /// ranking).
+    pub fn largest(&self, count: usize) -> Vec<bool> {
+        match &self.ranked {
+            Some(r) => {
+                let mut m = vec![false; self.marked.len()];
+                for &(t, _) in r.iter().take(count) {
+                    m[t] = true;
+                }
+                m
+            }
+            None => self.marked.clone(),
+        }
+    }
+
+    /// The share of the marked triangles' indicator that the `count` largest carry (1
+    /// without a ranking).
+    pub fn indicator_share(&self, count: usize) -> f64 {
+        let Some(r) = &self.ranked else { return 1.0 };
+        let total: f64 = r.iter().map(|v| v.1).sum();
+        if total > 0.0 {
+            r.iter().take(count).map(|v| v.1).sum::<f64>() / total
+        } else {
+            1.0
+        }
+    }
+}
+
+/// The size a level cut to the budget aims at, as a fraction of `accuracy.max_unknowns`.
+pub const BUDGET_FILL: f64 = 0.9;
+
+/// A level cut to the budget is not solved when the triangles that fit carry less than this
+/// share of the marked triangles' indicator: it would cost a level's solve for a change too
+/// small to bring an estimate down.
+pub const MIN_BUDGET_SHARE: f64 = 0.25;
+
+/// How many of the marked triangles (those of largest indicator) a level cut to `budget`
+/// refines: the count where the straight line from the level before (no triangle,
+/// `before` unknowns) to the smallest count found over the budget (`over`: count,
+/// unknowns) reaches [`BUDGET_FILL`] of it. The unknowns grow faster than that line with the
+/// first triangles (the largest indicators sit on the smallest elements, whose grading
+/// and solid reach far), so a count can still be over; the next try then brackets from
+/// it. Always below `over`'s count.
+pub fn cut_count(before: u64, over: (usize, u64), budget: u64) -> usize {
+    let (count, n) = over;
+    let room = BUDGET_FILL * budget as f64 - before as f64;
+    let added = n.saturating_sub(before) as f64;
+    let c = if added > 0.0 && room > 0.0 { (count as f64 * room / added) as usize } else { 0 };
+    c.min(count.saturating_sub(1))
 }
 
 /// The P2 interpolation weights of the film at `p` (units of a) on the contact face.
@@ -318,5 +385,22 @@ mod tests {
             }
         }
         assert!(finer.contact_tris.len() > mesh.contact_tris.len());
+    }
+
+    #[test]
+    fn a_level_over_the_budget_is_cut_to_the_count_of_its_marking_that_fits() {
+        // 400k before, 800k with all 1000 marked triangles: 140k of room below 90 % of a
+        // 600k budget for 400k added, so 350 of them.
+        assert_eq!(cut_count(400_000, (1000, 800_000), 600_000), 350);
+        // A cut still over brackets from itself: 350 gave 620k, so 350 * 140/220.
+        assert_eq!(cut_count(400_000, (350, 620_000), 600_000), 222);
+        // No room: none.
+        assert_eq!(cut_count(560_000, (1000, 1_000_000), 600_000), 0);
+        // The largest of the ranked: the first of the ranking, whatever their index, and
+        // the share of the indicator they carry.
+        let m = Marking { marked: vec![true, false, true, true], ranked: Some(vec![(3, 5.0), (0, 3.0), (2, 2.0)]) };
+        assert_eq!(m.largest(2), vec![true, false, false, true]);
+        assert!((m.indicator_share(2) - 0.8).abs() < 1e-12);
+        assert_eq!(Marking::unranked(vec![true, false]).largest(0), vec![true, false]);
     }
 }

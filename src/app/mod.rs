@@ -3,6 +3,7 @@
 pub mod adapt;
 pub mod cli;
 pub mod dry;
+mod estimate;
 mod face_files;
 mod first_level;
 pub mod lubricated;
