@@ -44,7 +44,7 @@ use std::time::Instant;
 pub const MIN_ADAPTIVE_SIZE: f64 = 16.0 / 4096.0;
 
 /// Meshes tried for a level cut to the budget (each a fraction of a second at 600,000
-/// unknowns): a cut that still exceeds it is cut again from there ([`cut_count`]).
+/// unknowns): a cut that still exceeds it is cut again from the meshes tried ([`cut_count`]).
 const MAX_CUTS: usize = 6;
 
 /// One level of the adaptive loop.
@@ -123,8 +123,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     // Where a failed first level got, with its mesh: the retry goes on from there ([`onward`]).
     let mut from: Option<Onward> = None;
     // How many of its marked triangles the present level refines when all of them would
-    // exceed the budget, with the share of the indicator they carry, and how often it was cut.
-    let (mut cut, mut cuts): (Option<(usize, f64)>, usize) = (None, 0);
+    // exceed the budget, with the share of the indicator they carry, and the meshes tried
+    // for it that were over the budget (count, unknowns).
+    let mut cut: Option<(usize, f64)> = None;
+    let mut over: Vec<(usize, u64)> = Vec::new();
     loop {
         let scene = &own;
         // The level being solved: one per converged level (a retried first level stays 0).
@@ -139,9 +141,15 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             // The level is cut to the budget: the marked triangles of largest indicator that
             // fit, once per run (a second cut would carry an estimate carried over already).
             let before = levels.last().map_or(0, |l| (l.elastic_unknowns + l.pressure_unknowns + 1) as u64);
-            let once = !levels.iter().any(|l| l.budget_share.is_some()) && cuts < MAX_CUTS;
-            if let Some((m, marked)) = prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| once) {
-                let count = cut_count(before, (cut.map_or(marked, |c| c.0), (n_u + n_p + 1) as u64), acc.max_unknowns);
+            let once = !levels.iter().any(|l| l.budget_share.is_some()) && over.len() < MAX_CUTS;
+            // Not when even the next full level's change could not take every estimate below
+            // the target.
+            let hopeful = Estimate::cut_could_reach(&levels, target);
+            if let Some((m, marked)) =
+                prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| once && hopeful)
+            {
+                over.push((cut.map_or(marked, |c| c.0), (n_u + n_p + 1) as u64));
+                let count = cut_count(before, &over, acc.max_unknowns);
                 let share = m.indicator_share(count);
                 if share >= MIN_BUDGET_SHARE {
                     ctx.log(format!(
@@ -151,11 +159,20 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         100.0 * share
                     ));
                     field = Some(Arc::new(next_field(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), &m.largest(count), growth)));
-                    (cut, cuts) = (Some((count, share)), cuts + 1);
+                    cut = Some((count, share));
                     continue;
                 }
             }
-            let why = format!("level {k} would have {} unknowns, above accuracy.max_unknowns = {}", n_u + n_p + 1, acc.max_unknowns);
+            let why = format!(
+                "level {k} would have {} unknowns, above accuracy.max_unknowns = {}{}",
+                n_u + n_p + 1,
+                acc.max_unknowns,
+                if !hopeful && once && prev.marking.as_ref().is_some_and(|m| m.ranked.is_some()) {
+                    " (a level cut to it could not take every estimate below the target)"
+                } else {
+                    ""
+                }
+            );
             let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
             return finish(ctx, scene, prev, target, &levels, Some(why));
         }
@@ -335,7 +352,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             est: None,
             budget_share: cut.take().map(|c| c.1),
         };
-        cuts = 0;
+        over.clear();
         levels.push(level);
         if k == 0 && acc.max_seconds > 0.0 {
             // The budget covers the levels after the first: a run always has a result.

@@ -341,7 +341,7 @@ pub const ACCURACY_FIELDS: &[Field] = &[
         "",
         Kind::Number(Range::Closed(1e4, 1e9)),
         Presence::Default("600000"),
-        note = "a level that would exceed it is not solved: the last level's result is written with its estimated error, summary.json says accuracy.reached = false, and the exit code is 4 (about 6.5 GB per rank on 2 ranks at 600,000; raise it on a larger machine)"
+        note = "a level that would exceed it refines only the marked triangles of largest indicator that fit, once per run, when even the next full level's change could take every estimate below the target; otherwise, or when those carry less than a quarter of the marked indicator, it is not solved: the last level's result is written with its estimated error, summary.json says accuracy.reached = false, and the exit code is 4 (6-7 GB per rank on 2 ranks at 600,000; raise it on a larger machine)"
     ),
     f!(
         "max_seconds",
