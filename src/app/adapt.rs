@@ -379,9 +379,13 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             level.est.map_or("- (first level)".to_string(), |e| e.describe())
         ));
         let reached = k >= 2 && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
+        // A level cut to the budget is the last: the level after it would refine the rest of
+        // its marking and more, over the budget, and would not be cut again.
+        let cut_level = levels.last().is_some_and(|l| l.budget_share.is_some());
+        let last = reached || k == max_levels || cut_level;
         // The next level's marking, while this level's fields are at hand (not when it is the
         // last), and the speed exponents when asked for: both from one adjoint LU.
-        let goal = !reached && k < max_levels && acc.marking > 0.0;
+        let goal = !last && acc.marking > 0.0;
         let mut adjoint = (goal || scene.output.speed_exponents).then(|| collective::agree(&ctx.world, solver.adjoint(ctx, scene, &sol.x)));
         let exponents = match (&mut adjoint, scene.output.speed_exponents) {
             (Some(Ok(a)), true) => Some(collective::agree(&ctx.world, super::sensitivity::speed_exponents(ctx, a, &fields, &st))),
@@ -389,7 +393,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             _ => None,
         };
         let exponents = exponents.map(|got| super::sensitivity::report(ctx, got));
-        let marked = if !reached && k < max_levels {
+        let marked = if !last {
             Some(match adjoint.as_ref().filter(|_| goal) {
                 // A failed adjoint costs this level's goal-oriented marking, not the run (an
                 // interruption is acted on at the check after the marking).
@@ -432,6 +436,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         if k == max_levels {
             let why = short_of(target, &format!("accuracy.max_levels = {max_levels} refinement levels solved"), k, est);
             return finish(ctx, scene, &here, target, &levels, Some(why));
+        }
+        if cut_level {
+            let why = format!("level {k} was cut to accuracy.max_unknowns = {}: the level after it would exceed it", acc.max_unknowns);
+            return finish(ctx, scene, &here, target, &levels, Some(short_of(target, &why, k, est)));
         }
         let marked = &here.marking.as_ref().expect("marked when the loop goes on").marked;
         if !marked.iter().any(|&m| m) {
