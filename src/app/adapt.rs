@@ -139,7 +139,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let (n_u, n_p) = setup.layout.counts();
         if let (Some(prev), true) = (&previous, (n_u + n_p + 1) as u64 > acc.max_unknowns) {
             // The level is cut to the budget: the marked triangles of largest indicator that
-            // fit, once per run (a second cut would carry an estimate carried over already).
+            // fit, once per run (a cut level is the last, below).
             let before = levels.last().map_or(0, |l| (l.elastic_unknowns + l.pressure_unknowns + 1) as u64);
             let once = !levels.iter().any(|l| l.budget_share.is_some()) && over.len() < MAX_CUTS;
             // Not when even the next full level's change could not take every estimate below
