@@ -139,15 +139,12 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let (n_u, n_p) = setup.layout.counts();
         if let (Some(prev), true) = (&previous, (n_u + n_p + 1) as u64 > acc.max_unknowns) {
             // The level is cut to the budget: the marked triangles of largest indicator that
-            // fit, once per run (a cut level is the last, below).
+            // fit, once per run (a cut level is the last, below), and not when even the next
+            // full level's change could not take every estimate below the target.
             let before = levels.last().map_or(0, |l| (l.elastic_unknowns + l.pressure_unknowns + 1) as u64);
-            let once = !levels.iter().any(|l| l.budget_share.is_some()) && over.len() < MAX_CUTS;
-            // Not when even the next full level's change could not take every estimate below
-            // the target.
-            let hopeful = Estimate::cut_could_reach(&levels, target);
-            if let Some((m, marked)) =
-                prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| once && hopeful)
-            {
+            let ranked = prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| over.len() < MAX_CUTS);
+            let hopeful = ranked.is_some() && Estimate::cut_could_reach(&levels, target);
+            if let Some((m, marked)) = ranked.filter(|_| hopeful) {
                 over.push((cut.map_or(marked, |c| c.0), (n_u + n_p + 1) as u64));
                 let count = cut_count(before, &over, acc.max_unknowns);
                 let share = m.indicator_share(count);
@@ -167,11 +164,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 "level {k} would have {} unknowns, above accuracy.max_unknowns = {}{}",
                 n_u + n_p + 1,
                 acc.max_unknowns,
-                if !hopeful && once && prev.marking.as_ref().is_some_and(|m| m.ranked.is_some()) {
-                    " (a level cut to it could not take every estimate below the target)"
-                } else {
-                    ""
-                }
+                if ranked.is_some() && !hopeful { " (a level cut to it could not take every estimate below the target)" } else { "" }
             );
             let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
             return finish(ctx, scene, prev, target, &levels, Some(why));

@@ -31,36 +31,21 @@ pub struct Estimate {
 impl Estimate {
     /// The estimate of the last level of `levels`, None before the second level.
     pub(super) fn of(levels: &[Level]) -> Option<Estimate> {
-        let series = |f: &dyn Fn(&Level) -> f64| levels.iter().map(f).collect::<Vec<f64>>();
         // A level cut to the budget refined part of what its marking asked for: its change
         // is not one of a sequence, so the estimate before it is carried over instead.
         let cut = levels.last().is_some_and(|l| l.budget_share.is_some());
-        let scaled = |q: &[f64], scale: f64| if cut { estimate_after_cut(q, scale) } else { estimate_scaled(q, scale) };
-        let relative = |q: &[f64]| scaled(q, q.last()?.abs());
-        let hc = relative(&series(&|l| l.hc))?;
-        let hm = relative(&series(&|l| l.hm))?;
-        let friction = levels.iter().map(|l| l.friction).collect::<Option<Vec<[f64; 2]>>>().and_then(|f| {
-            let last = f.last()?;
-            let scale = last[0].hypot(last[1]);
-            let fx: Vec<f64> = f.iter().map(|v| v[0]).collect();
-            let fz: Vec<f64> = f.iter().map(|v| v[1]).collect();
-            Some([scaled(&fx, scale)?, scaled(&fz, scale)?])
-        });
-        Some(Estimate { hc, hm, friction })
+        let e = sequences(levels)
+            .iter()
+            .map(|(q, scale)| if cut { estimate_after_cut(q, *scale) } else { estimate_scaled(q, *scale) })
+            .collect::<Option<Vec<f64>>>()?;
+        Some(Estimate { hc: e[0], hm: e[1], friction: (e.len() == 4).then(|| [e[2], e[3]]) })
     }
 
     /// Whether a level cut to the budget after the last of `levels` could bring every
     /// estimate below `target` ([`least_after_cut`]): when not, it is not solved (on
     /// cases/hard/spin-0.33deg it cost 800 s and moved fx's estimate from 1.31 % to 1.29 %).
     pub(super) fn cut_could_reach(levels: &[Level], target: f64) -> bool {
-        let series = |f: &dyn Fn(&Level) -> f64| levels.iter().map(f).collect::<Vec<f64>>();
-        let below = |q: &[f64], scale: f64| least_after_cut(q, scale).is_some_and(|e| e < target);
-        let films = [series(&|l| l.hc), series(&|l| l.hm)].iter().all(|q| q.last().is_some_and(|v| below(q, v.abs())));
-        let friction = levels.iter().map(|l| l.friction).collect::<Option<Vec<[f64; 2]>>>().map_or(true, |f| {
-            let scale = f.last().map_or(0.0, |v| v[0].hypot(v[1]));
-            (0..2).all(|c| below(&f.iter().map(|v| v[c]).collect::<Vec<f64>>(), scale))
-        });
-        films && friction
+        sequences(levels).iter().all(|(q, scale)| least_after_cut(q, *scale).is_some_and(|e| e < target))
     }
 
     /// Every estimated error.
@@ -87,6 +72,22 @@ impl Estimate {
         }
         v
     }
+}
+
+/// Each target value's sequence over `levels` with the scale its error is taken relative
+/// to: hc and hm against their last value; with friction on every level, fx and fz against
+/// the last friction coefficient's magnitude.
+fn sequences(levels: &[Level]) -> Vec<(Vec<f64>, f64)> {
+    let relative = |q: Vec<f64>| {
+        let scale = q.last().map_or(0.0, |v| v.abs());
+        (q, scale)
+    };
+    let mut all = vec![relative(levels.iter().map(|l| l.hc).collect()), relative(levels.iter().map(|l| l.hm).collect())];
+    if let Some(f) = levels.iter().map(|l| l.friction).collect::<Option<Vec<[f64; 2]>>>() {
+        let scale = f.last().map_or(0.0, |v| v[0].hypot(v[1]));
+        all.extend((0..2).map(|c| (f.iter().map(|v| v[c]).collect(), scale)));
+    }
+    all
 }
 
 /// The estimated relative error of the last value of `q` (see the module documentation).
