@@ -141,6 +141,14 @@ impl Matrix {
         pcall!(ffi::MatMult(self.raw, x.raw, y.raw))
     }
 
+    /// A new matrix holding the transpose (`MatTranspose`), of the same type: for a
+    /// transposed solve with a factorisation that has none (ScaLAPACK's LU).
+    pub fn transposed(&self) -> Result<Matrix> {
+        let mut raw: ffi::Mat = std::ptr::null_mut();
+        pcall!(ffi::MatTranspose(self.raw, ffi::MatReuse_MAT_INITIAL_MATRIX, &mut raw))?;
+        Ok(Matrix { raw })
+    }
+
     /// Global number of stored non-zeros.
     pub fn nonzeros(&self) -> Result<f64> {
         let mut info = ffi::MatInfo::default();

@@ -20,13 +20,15 @@ use super::problem::{ehl_params, lubricant};
 use super::EhlSolver;
 use crate::case::Scene;
 use crate::context::Context;
+use crate::ehl::condensed::CondensedSystem;
 use crate::ehl::layout::Layout;
 use crate::ehl::prealloc::preallocation;
-use crate::ehl::system::EhlSystem;
+use crate::ehl::system::{EhlParams, EhlSystem};
 use crate::error::Error;
 use crate::petsc::snes::{Eval, Problem};
 use crate::petsc::{self, Ksp, Matrix, Vector};
 use crate::solid::assembly;
+use crate::solid::condense::Compliance;
 
 /// Options prefix of the adjoint's linear solver (`-adjoint_ksp_type`, ...).
 pub const ADJOINT_PREFIX: &str = "adjoint_";
@@ -36,28 +38,70 @@ pub const ADJOINT_PREFIX: &str = "adjoint_";
 /// difference is exact to O(1e-8) and the roundoff of F(x) ~ 0 stays near 1e-12 of dF/ds.
 const SPEED_STEP: f64 = 1e-4;
 
-/// The transposed LU of the monolithic Jacobian at a converged state: adjoints of film
-/// values. Collective in every method.
+/// The adjoints of film values at a converged state, from one LU. Collective in every
+/// method. An adjoint z is in the layout of the system it was solved on (monolithic, or
+/// condensed: P and H0); [`Adjoint::pressure_part`] reads it per mesh node, and
+/// [`film_derivative`] pairs it with [`Adjoint::residual_speed_derivative`] of the same
+/// system.
 pub struct Adjoint<'a> {
-    system: EhlSystem<'a>,
-    layout: &'a Layout,
-    x: &'a [f64],
+    form: Form<'a>,
     // Declared before the matrix: the solver holds a reference to it.
     ksp: Ksp,
-    _jacobian: Matrix,
+    _matrix: Matrix,
     local: usize,
+}
+
+/// The system an adjoint is solved on.
+enum Form<'a> {
+    /// U, P and H0: the transposed MUMPS LU of the sparse Jacobian.
+    Monolithic { system: EhlSystem<'a>, layout: &'a Layout, x: &'a [f64] },
+    /// The elastic block condensed onto the face (the level was solved so): the dense
+    /// Jacobian in (P, H0), transposed and factorised. Eliminating U from J^T z = g gives
+    /// J_c^T (z_P, z_H0) = (g_P + C^T g_Uy, g_H0) with C the face compliance: the same
+    /// pressure and H0 parts as the monolithic adjoint, without the elastic LU. The
+    /// displacement part is not formed: nothing reads it (the residual's speed derivative
+    /// and the marking live in the Reynolds rows).
+    Condensed { system: CondensedSystem<'a>, comp: &'a Compliance, x: Vec<f64> },
 }
 
 impl EhlSolver<'_> {
     /// The adjoint machinery at the converged state `x` (monolithic layout,
-    /// [`super::EhlSolution::x`], whatever coupling solved it): the Jacobian assembled and
-    /// factorised once (MUMPS, prefix `adjoint_`). Collective.
+    /// [`super::EhlSolution::x`]): on the coupling the level was solved with, the Jacobian
+    /// assembled and factorised once (prefix `adjoint_`). Collective.
     pub fn adjoint<'s>(&'s self, ctx: &'s Context, scene: &Scene, x: &'s [f64]) -> Result<Adjoint<'s>, Error> {
         let (mesh, layout) = (self.mesh, self.layout);
         let comm = petsc::comm_world();
         let eq = scene.equivalent_solid();
-        let k = assembly::assemble_stiffness(comm, mesh, self.part, self.dofs, ctx.rank, eq.nu)?;
         let params = ehl_params(scene, eq.nu, self.half);
+        if let Some(comp) = &self.comp {
+            let mut system = CondensedSystem::new(mesh, comp, ctx.size, ctx.rank, params, lubricant(scene));
+            let cl = system.layout.clone();
+            let mut xc = vec![0.0; cl.total()];
+            for (j, &n) in comp.cols.iter().enumerate() {
+                xc[j] = x[layout.p[n as usize] as usize];
+            }
+            xc[cl.h0()] = x[layout.h0 as usize];
+            let (d_nnz, o_nnz) = system.preallocation();
+            let local = cl.local(ctx.rank);
+            let j = if comp.is_rigid() {
+                Matrix::new_aij(comm, local, &d_nnz, &o_nnz)?
+            } else {
+                let j = Matrix::new_dense(comm, local, super::CONDENSED_PREFIX, &d_nnz, &o_nnz)?;
+                let (rows, cols) = j.dense_fill_block(cl.total())?;
+                system.set_fill_block(rows, cols);
+                j
+            };
+            system.jacobian(&xc, &j)?;
+            j.assemble()?;
+            // ScaLAPACK's LU has no transposed solve: the transpose is factorised instead.
+            let jt = j.transposed()?;
+            drop(j);
+            petsc::ksp::set_direct_solver_defaults_for(ADJOINT_PREFIX, &jt)?;
+            let ksp = Ksp::with_prefix(comm, &jt, ADJOINT_PREFIX)?;
+            let form = Form::Condensed { system, comp, x: xc };
+            return Ok(Adjoint { form, ksp, _matrix: jt, local });
+        }
+        let k = assembly::assemble_stiffness(comm, mesh, self.part, self.dofs, ctx.rank, eq.nu)?;
         let (d_nnz, o_nnz) = preallocation(mesh, self.part, layout, ctx.rank, params.stabilisation.jump > 0.0);
         let local = layout.local(ctx.rank);
         let j = Matrix::new_aij(comm, local, &d_nnz, &o_nnz)?;
@@ -67,13 +111,13 @@ impl EhlSolver<'_> {
         petsc::ksp::set_direct_solver_defaults(ADJOINT_PREFIX)?;
         petsc::options::set_default(&format!("-{ADJOINT_PREFIX}mat_mumps_icntl_7"), "4")?;
         let ksp = Ksp::with_prefix(comm, &j, ADJOINT_PREFIX)?;
-        Ok(Adjoint { system, layout, x, ksp, _jacobian: j, local })
+        Ok(Adjoint { form: Form::Monolithic { system, layout, x }, ksp, _matrix: j, local })
     }
 }
 
 impl Adjoint<'_> {
     /// The adjoint z of the film value with nodal weights `weights` (summing to 1), whole,
-    /// on every rank (monolithic layout).
+    /// on every rank.
     pub fn film(&self, ctx: &Context, weights: &[(u32, f64)]) -> Result<Vec<f64>, Error> {
         self.functional(ctx, weights, &[])
     }
@@ -88,48 +132,90 @@ impl Adjoint<'_> {
         b.set_all(0.0)?;
         if ctx.rank == 0 {
             let h0: f64 = dh.iter().map(|&(_, w)| w).sum();
-            let rows: Vec<i32> = dh
-                .iter()
-                .map(|&(n, _)| self.layout.u[n as usize][1])
-                .chain([self.layout.h0])
-                .chain(dp.iter().map(|&(n, _)| self.layout.p[n as usize]))
-                .collect();
-            let vals: Vec<f64> = dh.iter().map(|&(_, w)| -w).chain([h0]).chain(dp.iter().map(|&(_, w)| w)).collect();
+            let (rows, vals): (Vec<i32>, Vec<f64>) = match &self.form {
+                Form::Monolithic { layout, .. } => dh
+                    .iter()
+                    .map(|&(n, w)| (layout.u[n as usize][1], -w))
+                    .chain([(layout.h0, h0)])
+                    .chain(dp.iter().map(|&(n, w)| (layout.p[n as usize], w)))
+                    .unzip(),
+                Form::Condensed { system, comp, .. } => {
+                    let cl = &system.layout;
+                    // g_P + C^T g_Uy, with g_Uy = -dh on the face rows.
+                    let mut g = vec![0.0; cl.total()];
+                    for &(n, w) in dp {
+                        if let Some(&j) = cl.p_index.get(n as usize).filter(|&&j| j >= 0) {
+                            g[j as usize] += w;
+                        }
+                    }
+                    if !comp.is_rigid() {
+                        let ncols = comp.cols.len();
+                        for &(n, w) in dh {
+                            let i = cl.face_index[n as usize];
+                            if i >= 0 {
+                                let row = &comp.c[i as usize * ncols..(i as usize + 1) * ncols];
+                                for (gj, c) in g.iter_mut().zip(row) {
+                                    *gj -= w * c;
+                                }
+                            }
+                        }
+                    }
+                    g[cl.h0()] += h0;
+                    g.iter().enumerate().map(|(i, &v)| (i as i32, v)).unzip()
+                }
+            };
             // Added, so that a repeated row sums; the rows of nodes without a pressure
             // unknown (negative) are dropped.
             b.set_values(&rows, &vals, true)?;
         }
         b.assemble()?;
-        self.ksp.solve_transpose(&b, &z)?;
+        match self.form {
+            Form::Monolithic { .. } => self.ksp.solve_transpose(&b, &z)?,
+            Form::Condensed { .. } => self.ksp.solve(&b, &z).map(|_| ())?,
+        }
         Ok(z.gather_all()?)
     }
 
     /// The pressure part of an adjoint `z`, per mesh node (0 where a node has no pressure
     /// unknown).
     pub fn pressure_part(&self, z: &[f64]) -> Vec<f64> {
-        self.layout.p.iter().map(|&d| if d >= 0 { z[d as usize] } else { 0.0 }).collect()
+        let index: &[i32] = match &self.form {
+            Form::Monolithic { layout, .. } => &layout.p,
+            Form::Condensed { system, .. } => &system.layout.p_index,
+        };
+        index.iter().map(|&d| if d >= 0 { z[d as usize] } else { 0.0 }).collect()
     }
 
-    /// dF/d(ln lambda_bar) at the converged state, whole, on every rank.
+    /// dF/d(ln lambda_bar) at the converged state, whole, on every rank, in the layout of
+    /// the adjoints.
     pub fn residual_speed_derivative(&mut self) -> Result<Vec<f64>, Error> {
-        let lambda = self.system.params.lambda_bar;
-        let penalty = self.system.params.penalty;
-        let mut at = |s: f64| -> Result<Vec<f64>, Error> {
-            self.system.params.set_operating(lambda * s.exp(), penalty);
-            let f = Vector::new(petsc::comm_world(), self.local)?;
-            f.set_all(0.0)?;
-            let eval = self.system.residual(self.x, &f)?;
-            f.assemble()?;
-            match eval {
-                Eval::Ok => Ok(f.gather_all()?),
-                Eval::Domain(why) => Err(Error::numerical(format!("the speed derivative left the film's domain: {why}"))),
-            }
-        };
-        let (plus, minus) = (at(SPEED_STEP), at(-SPEED_STEP));
-        self.system.params.set_operating(lambda, penalty);
-        let (plus, minus) = (plus?, minus?);
-        Ok(plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * SPEED_STEP)).collect())
+        let local = self.local;
+        match &mut self.form {
+            Form::Monolithic { system, x, .. } => speed_derivative(system, |s| &mut s.params, x, local),
+            Form::Condensed { system, x, .. } => speed_derivative(system, |s| &mut s.params, x, local),
+        }
     }
+}
+
+/// dF/d(ln lambda_bar) of `system` at `x` by a central difference (`params` reaches the
+/// system's parameters), whole, on every rank.
+fn speed_derivative<S: Problem>(system: &mut S, params: fn(&mut S) -> &mut EhlParams, x: &[f64], local: usize) -> Result<Vec<f64>, Error> {
+    let (lambda, penalty) = (params(system).lambda_bar, params(system).penalty);
+    let mut at = |s: f64| -> Result<Vec<f64>, Error> {
+        params(system).set_operating(lambda * s.exp(), penalty);
+        let f = Vector::new(petsc::comm_world(), local)?;
+        f.set_all(0.0)?;
+        let eval = system.residual(x, &f)?;
+        f.assemble()?;
+        match eval {
+            Eval::Ok => Ok(f.gather_all()?),
+            Eval::Domain(why) => Err(Error::numerical(format!("the speed derivative left the film's domain: {why}"))),
+        }
+    };
+    let (plus, minus) = (at(SPEED_STEP), at(-SPEED_STEP));
+    params(system).set_operating(lambda, penalty);
+    let (plus, minus) = (plus?, minus?);
+    Ok(plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * SPEED_STEP)).collect())
 }
 
 /// dJ/ds = -z . dF/ds for an adjoint `z` and a residual derivative `df` (both whole).

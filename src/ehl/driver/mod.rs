@@ -91,7 +91,7 @@ impl<'a> EhlSolver<'a> {
         layout: &'a Layout,
         half: bool,
     ) -> Result<Self, Error> {
-        set_newton_defaults()?;
+        set_newton_defaults(scene.accuracy.target)?;
         let p_nodes = pressure_nodes(mesh, layout);
         let coupling = Coupling::of_scene(scene, p_nodes.len());
         let (rigid, monolithic) = (coupling == Coupling::Rigid, coupling == Coupling::Monolithic);
