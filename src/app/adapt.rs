@@ -169,10 +169,12 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
             return finish(ctx, scene, prev, target, &levels, Some(why));
         }
-        let solver = match EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half) {
+        let mut solver = match EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half) {
             Ok(s) => s,
             Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
         };
+        // The adjoint after the level solves on Newton's last factorisation.
+        solver.keep_newton(acc.marking > 0.0 || scene.output.speed_exponents);
         let sol = match (&previous, earlier) {
             (Some(prev), _) => {
                 let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);

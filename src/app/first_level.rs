@@ -139,7 +139,7 @@ pub(super) enum Onward {
 ///   coarser level's (plain Newton, the continuation from it, then the Hertz start).
 ///   cases/hard/spin-0.33deg's retry (166,728 unknowns) spent 305 s in plain Newton from
 ///   the Hertz start and did not converge.
-pub(super) fn onward(ctx: &Context, scene: &Scene, solver: &EhlSolver, from: Option<&Onward>) -> Result<EhlSolution, Error> {
+pub(super) fn onward<'a>(ctx: &'a Context, scene: &Scene, solver: &EhlSolver<'a>, from: Option<&Onward>) -> Result<EhlSolution, Error> {
     let (setup, x, reached) = match from {
         None => return solver.solve(ctx, scene, None),
         Some(Onward::Reached(setup, r)) => (setup, &r.x, Some(r)),

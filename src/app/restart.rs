@@ -141,11 +141,11 @@ impl EarlierRun {
 
     /// Newton from this run's pressure for `scene` (whose scales may differ from the
     /// earlier scene's), falling back to the Hertz start. Collective.
-    pub fn solve(
+    pub fn solve<'a>(
         &self,
-        ctx: &super::Context,
+        ctx: &'a super::Context,
         scene: &Scene,
-        solver: &crate::ehl::driver::EhlSolver,
+        solver: &crate::ehl::driver::EhlSolver<'a>,
     ) -> Result<crate::ehl::driver::EhlSolution, Error> {
         let hertz = scene.hertz();
         let (a, ph) = (hertz.a, hertz.ph);

@@ -35,7 +35,7 @@ fn point_label(p: &Scene) -> String {
     )
 }
 
-pub fn run(ctx: &Context, scene: &Scene, setup: &Setup, solver: &EhlSolver) -> Result<(), Error> {
+pub fn run<'a>(ctx: &'a Context, scene: &Scene, setup: &Setup, solver: &EhlSolver<'a>) -> Result<(), Error> {
     let points = scene.points();
     let n = points.len();
     ctx.log(format!("sweep: {n} operating points on one mesh"));

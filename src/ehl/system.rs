@@ -227,6 +227,12 @@ impl<'a> EhlSystem<'a> {
         })
     }
 
+    /// The factor of every scaled row (the Reynolds rows after `scale_rows`), as
+    /// (global row, factor); rows not listed are unscaled.
+    pub fn row_scales(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.row_scale.iter().map(|(&d, &s)| (d as usize, s))
+    }
+
     fn scale_of(&self, row: i32) -> f64 {
         if row < 0 {
             return 0.0;

@@ -35,6 +35,11 @@ pub struct Ksp {
 }
 
 impl Ksp {
+    /// Wraps a solver the caller holds a reference to (released on drop).
+    pub(super) fn from_raw(raw: ffi::KSP) -> Ksp {
+        Ksp { raw }
+    }
+
     /// Creates a solver for operator `a`, configured from the options database.
     pub fn new(comm: ffi::MPI_Comm, a: &Matrix) -> Result<Ksp> {
         Ksp::with_prefix(comm, a, "")
@@ -97,6 +102,28 @@ impl Ksp {
     pub fn solve_transpose(&self, b: &Vector, x: &Vector) -> Result<()> {
         pcall!(ffi::KSPSolveTranspose(self.raw, b.raw, x.raw))?;
         self.outcome("transposed linear solve").map(|_| ())
+    }
+
+    /// Makes this solver GMRES to the relative tolerance `rtol` (at most `max_it`
+    /// iterations) on its operator, preconditioned by the factorisation it holds, which is
+    /// not made again when the operator's values change: solves with a matrix near the one
+    /// factorised.
+    pub fn krylov_on_present_factor(&self, rtol: f64, max_it: usize) -> Result<()> {
+        pcall!(ffi::KSPSetType(self.raw, ffi::KSPGMRES.as_ptr() as *const _))?;
+        pcall!(ffi::KSPSetReusePreconditioner(self.raw, ffi::PetscBool_PETSC_TRUE))?;
+        // A Newton solver's KSP carries SNES's Eisenstat-Walker hooks, which would reset
+        // the tolerance below to the forcing term of its last step.
+        pcall!(ffi::KSPSetPreSolve(self.raw, None, std::ptr::null_mut()))?;
+        pcall!(ffi::KSPSetPostSolve(self.raw, None, std::ptr::null_mut()))?;
+        let default = ffi::PETSC_DEFAULT as f64;
+        pcall!(ffi::KSPSetTolerances(self.raw, rtol, default, default, max_it as ffi::PetscInt))
+    }
+
+    /// The iterations of the last solve.
+    pub fn iterations(&self) -> Result<usize> {
+        let mut its: ffi::PetscInt = 0;
+        pcall!(ffi::KSPGetIterationNumber(self.raw, &mut its))?;
+        Ok(its as usize)
     }
 
     /// Memory MUMPS used for the factorisation (MB, summed over the ranks: INFOG(22)),

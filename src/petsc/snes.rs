@@ -242,6 +242,15 @@ impl Snes {
         super::factor::last_failure(ksp)
     }
 
+    /// The Krylov solver of the Newton steps, with the factorisation it last made (a new
+    /// reference: it outlives this SNES if kept).
+    pub fn ksp(&self) -> Result<super::Ksp> {
+        let mut ksp: ffi::KSP = std::ptr::null_mut();
+        pcall!(ffi::SNESGetKSP(self.raw, &mut ksp))?;
+        pcall!(ffi::PetscObjectReference(ksp as ffi::PetscObject))?;
+        Ok(super::Ksp::from_raw(ksp))
+    }
+
     /// Raw handle for FFI calls.
     pub fn raw(&self) -> ffi::SNES {
         self.raw

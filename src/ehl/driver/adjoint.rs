@@ -18,6 +18,7 @@
 //! in s on the same mesh and state.
 use super::problem::{ehl_params, lubricant};
 use super::EhlSolver;
+use super::Kept;
 use crate::case::Scene;
 use crate::context::Context;
 use crate::ehl::condensed::CondensedSystem;
@@ -45,23 +46,48 @@ const SPEED_STEP: f64 = 1e-4;
 /// system.
 pub struct Adjoint<'a> {
     form: Form<'a>,
-    // Declared before the matrix: the solver holds a reference to it.
-    ksp: Ksp,
-    _matrix: Matrix,
     local: usize,
 }
 
+/// Relative tolerance of the adjoint's GMRES on Newton's last factorisation: the adjoint
+/// to about the precision of a direct solve.
+const KRYLOV_RTOL: f64 = 1e-10;
+
+/// GMRES iterations allowed on Newton's last factorisation before a new LU is made
+/// instead (measured: 3-6 on the adaptive levels of table2-ue2).
+const KRYLOV_MAX_IT: usize = 50;
+
 /// The system an adjoint is solved on.
 enum Form<'a> {
-    /// U, P and H0: the transposed MUMPS LU of the sparse Jacobian.
-    Monolithic { system: EhlSystem<'a>, layout: &'a Layout, x: &'a [f64] },
+    /// U, P and H0 on a new transposed MUMPS LU of the sparse Jacobian.
+    Monolithic {
+        system: EhlSystem<'a>,
+        layout: &'a Layout,
+        x: &'a [f64],
+        // Declared before the matrix: the solver holds a reference to it.
+        ksp: Ksp,
+        _jacobian: Matrix,
+    },
+    /// U, P and H0 on the converged solve's own Newton solver: its Jacobian made again at
+    /// the solution, GMRES on the transposed system preconditioned by the LU Newton made
+    /// last (at most two steps before, with the LU reused over steps). The system's
+    /// Reynolds rows are scaled (by D): the solve gives y with J^T D y = g, so z = D y, and
+    /// the residual's derivative is unscaled the same way.
+    Newton { kept: Kept<'a>, layout: &'a Layout, x: &'a [f64], ksp: Ksp },
     /// The elastic block condensed onto the face (the level was solved so): the dense
     /// Jacobian in (P, H0), transposed and factorised. Eliminating U from J^T z = g gives
     /// J_c^T (z_P, z_H0) = (g_P + C^T g_Uy, g_H0) with C the face compliance: the same
     /// pressure and H0 parts as the monolithic adjoint, without the elastic LU. The
     /// displacement part is not formed: nothing reads it (the residual's speed derivative
     /// and the marking live in the Reynolds rows).
-    Condensed { system: CondensedSystem<'a>, comp: &'a Compliance, x: Vec<f64> },
+    Condensed {
+        system: CondensedSystem<'a>,
+        comp: &'a Compliance,
+        x: Vec<f64>,
+        // Declared before the matrix: the solver holds a reference to it.
+        ksp: Ksp,
+        _transposed: Matrix,
+    },
 }
 
 impl EhlSolver<'_> {
@@ -98,12 +124,25 @@ impl EhlSolver<'_> {
             drop(j);
             petsc::ksp::set_direct_solver_defaults_for(ADJOINT_PREFIX, &jt)?;
             let ksp = Ksp::with_prefix(comm, &jt, ADJOINT_PREFIX)?;
-            let form = Form::Condensed { system, comp, x: xc };
-            return Ok(Adjoint { form, ksp, _matrix: jt, local });
+            let form = Form::Condensed { system, comp, x: xc, ksp, _transposed: jt };
+            return Ok(Adjoint { form, local });
+        }
+        let local = layout.local(ctx.rank);
+        if let Some(mut kept) = self.kept.borrow_mut().take() {
+            let solved = (|| -> Result<Ksp, Error> {
+                kept.system.jacobian(x, &kept.jacobian)?;
+                kept.jacobian.assemble()?;
+                let ksp = kept.snes.ksp()?;
+                ksp.krylov_on_present_factor(KRYLOV_RTOL, KRYLOV_MAX_IT)?;
+                Ok(ksp)
+            })();
+            match solved {
+                Ok(ksp) => return Ok(Adjoint { form: Form::Newton { kept, layout, x, ksp }, local }),
+                Err(e) => ctx.log(format!("adjoint: Newton's factorisation could not be used ({e}); a new LU instead")),
+            }
         }
         let k = assembly::assemble_stiffness(comm, mesh, self.part, self.dofs, ctx.rank, eq.nu)?;
         let (d_nnz, o_nnz) = preallocation(mesh, self.part, layout, ctx.rank, params.stabilisation.jump > 0.0);
-        let local = layout.local(ctx.rank);
         let j = Matrix::new_aij(comm, local, &d_nnz, &o_nnz)?;
         let mut system = EhlSystem::new(&ctx.world, mesh, self.part, self.dofs, layout, ctx.rank, params, lubricant(scene), k)?;
         system.jacobian(x, &j)?;
@@ -111,7 +150,7 @@ impl EhlSolver<'_> {
         petsc::ksp::set_direct_solver_defaults(ADJOINT_PREFIX)?;
         petsc::options::set_default(&format!("-{ADJOINT_PREFIX}mat_mumps_icntl_7"), "4")?;
         let ksp = Ksp::with_prefix(comm, &j, ADJOINT_PREFIX)?;
-        Ok(Adjoint { form: Form::Monolithic { system, layout, x }, ksp, _matrix: j, local })
+        Ok(Adjoint { form: Form::Monolithic { system, layout, x, ksp, _jacobian: j }, local })
     }
 }
 
@@ -133,7 +172,7 @@ impl Adjoint<'_> {
         if ctx.rank == 0 {
             let h0: f64 = dh.iter().map(|&(_, w)| w).sum();
             let (rows, vals): (Vec<i32>, Vec<f64>) = match &self.form {
-                Form::Monolithic { layout, .. } => dh
+                Form::Monolithic { layout, .. } | Form::Newton { layout, .. } => dh
                     .iter()
                     .map(|&(n, w)| (layout.u[n as usize][1], -w))
                     .chain([(layout.h0, h0)])
@@ -169,9 +208,20 @@ impl Adjoint<'_> {
             b.set_values(&rows, &vals, true)?;
         }
         b.assemble()?;
-        match self.form {
-            Form::Monolithic { .. } => self.ksp.solve_transpose(&b, &z)?,
-            Form::Condensed { .. } => self.ksp.solve(&b, &z).map(|_| ())?,
+        match &self.form {
+            Form::Monolithic { ksp, .. } => ksp.solve_transpose(&b, &z)?,
+            Form::Condensed { ksp, .. } => ksp.solve(&b, &z).map(|_| ())?,
+            Form::Newton { kept, ksp, .. } => {
+                ksp.solve_transpose(&b, &z)?;
+                if crate::ehl_options::get().monitor && ctx.rank == 0 {
+                    eprintln!("ehl_monitor: adjoint on Newton's factorisation: {} GMRES iterations", ksp.iterations()?);
+                }
+                let mut z = z.gather_all()?;
+                for (d, s) in kept.system.row_scales() {
+                    z[d] *= s;
+                }
+                return Ok(z);
+            }
         }
         Ok(z.gather_all()?)
     }
@@ -180,7 +230,7 @@ impl Adjoint<'_> {
     /// unknown).
     pub fn pressure_part(&self, z: &[f64]) -> Vec<f64> {
         let index: &[i32] = match &self.form {
-            Form::Monolithic { layout, .. } => &layout.p,
+            Form::Monolithic { layout, .. } | Form::Newton { layout, .. } => &layout.p,
             Form::Condensed { system, .. } => &system.layout.p_index,
         };
         index.iter().map(|&d| if d >= 0 { z[d as usize] } else { 0.0 }).collect()
@@ -193,6 +243,13 @@ impl Adjoint<'_> {
         match &mut self.form {
             Form::Monolithic { system, x, .. } => speed_derivative(system, |s| &mut s.params, x, local),
             Form::Condensed { system, x, .. } => speed_derivative(system, |s| &mut s.params, x, local),
+            Form::Newton { kept, x, .. } => {
+                let mut df = speed_derivative(&mut kept.system, |s| &mut s.params, x, local)?;
+                for (d, s) in kept.system.row_scales() {
+                    df[d] /= s;
+                }
+                Ok(df)
+            }
         }
     }
 }

@@ -40,6 +40,9 @@ pub(super) struct NewtonOutcome {
     /// layout. A finer mesh's continuation starts there and ramps through the same values
     /// ([`MilderStart`]).
     pub(super) milder: Option<ContinuationPath>,
+    /// The solver of the last Newton solve, with the factorisation it last made: the
+    /// monolithic adjoint solves on it ([`super::Kept`]).
+    pub(super) snes: Snes,
 }
 
 /// The path of a continuation that reached the scene: the continuation's name, the values
@@ -587,7 +590,7 @@ pub(super) fn newton_with_continuation(
         });
     };
     let last = last.clone();
-    Ok(NewtonOutcome { x: xs, report: last, newton_total: nw.iterations, steps: nw.steps, continued, milder: reached_from })
+    Ok(NewtonOutcome { x: xs, report: last, newton_total: nw.iterations, steps: nw.steps, continued, milder: reached_from, snes: nw.snes })
 }
 
 #[cfg(test)]

@@ -76,6 +76,18 @@ pub struct EhlSolver<'a> {
     /// Seconds spent condensing the elastic block (None: no condensation phase, i.e.
     /// rigid solids or the monolithic coupling).
     pub condensation_s: Option<f64>,
+    /// Keep the last monolithic Newton solver for [`EhlSolver::adjoint`] ([`EhlSolver::keep_newton`]).
+    keep: bool,
+    kept: std::cell::RefCell<Option<Kept<'a>>>,
+}
+
+/// A converged monolithic solve's Newton solver, its Jacobian matrix and its system (with
+/// the row scaling the solver's factorisation was made with): the adjoint solves on that
+/// factorisation instead of a new LU.
+pub(super) struct Kept<'a> {
+    pub(super) snes: crate::petsc::snes::Snes,
+    pub(super) jacobian: Matrix,
+    pub(super) system: EhlSystem<'a>,
 }
 
 impl<'a> EhlSolver<'a> {
@@ -131,7 +143,19 @@ impl<'a> EhlSolver<'a> {
         };
         let condensation_s = (!rigid && !monolithic).then(|| t0.elapsed().as_secs_f64());
         crate::interrupt::check("the elastic condensation")?;
-        Ok(EhlSolver { mesh, part, dofs, layout, half, coupling, comp, condensation_s })
+        Ok(EhlSolver { mesh, part, dofs, layout, half, coupling, comp, condensation_s, keep: false, kept: Default::default() })
+    }
+
+    /// Keep the Newton solver of each converged monolithic solve until the next solve or
+    /// [`EhlSolver::adjoint`], which then solves on its factorisation (one MUMPS LU fewer
+    /// per level; the factorisation's memory stays in use meanwhile). Off by default.
+    pub fn keep_newton(&mut self, yes: bool) {
+        self.keep = yes;
+    }
+
+    /// Releases a kept Newton solver (its factorisation's memory), if any.
+    pub fn release_newton(&self) {
+        self.kept.borrow_mut().take();
     }
 
     /// The coupling this solver uses.
@@ -142,7 +166,7 @@ impl<'a> EhlSolver<'a> {
     /// Solves the scene's operating point. `start`: a converged state of a neighbouring
     /// operating point (monolithic layout, as in [`EhlSolution::x`]); when Newton fails
     /// from it, the solve starts over from the Hertz start. Collective.
-    pub fn solve(&self, ctx: &Context, scene: &Scene, start: Option<&[f64]>) -> Result<EhlSolution, Error> {
+    pub fn solve(&self, ctx: &'a Context, scene: &Scene, start: Option<&[f64]>) -> Result<EhlSolution, Error> {
         self.solve_from(ctx, scene, start.map_or(Start::Hertz, Start::Previous))
     }
 
@@ -151,9 +175,18 @@ impl<'a> EhlSolver<'a> {
     /// mesh's pressure then the continuation from that pressure), then the Hertz start with
     /// its automatic continuation (not after a start without its last resorts: its last
     /// failure is returned). Collective.
-    pub fn solve_from(&self, ctx: &Context, scene: &Scene, start: Start) -> Result<EhlSolution, Error> {
+    pub fn solve_from(&self, ctx: &'a Context, scene: &Scene, start: Start) -> Result<EhlSolution, Error> {
+        // A solver kept from the solve before: its memory is freed before this one factorises.
+        self.release_newton();
         let once = |start: Start, attempt: Attempt| match &self.comp {
-            None => solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, attempt),
+            None => {
+                solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, attempt).map(|(s, kept)| {
+                    if self.keep {
+                        *self.kept.borrow_mut() = Some(kept);
+                    }
+                    s
+                })
+            }
             Some(comp) => solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, start, attempt),
         };
         if !matches!(start, Start::Hertz) {
@@ -323,19 +356,19 @@ fn solve_condensed(
 }
 
 /// The monolithic path: U, P and H0 in one sparse system, from the Hertz start or from a
-/// previous state `start` (same layout).
+/// previous state `start` (same layout). Returns the solution and its Newton solver.
 #[allow(clippy::too_many_arguments)]
-fn solve_monolithic(
-    ctx: &Context,
+fn solve_monolithic<'a>(
+    ctx: &'a Context,
     scene: &Scene,
-    mesh: &Mesh,
-    part: &Partition,
-    dofs: &DofMap,
-    layout: &Layout,
+    mesh: &'a Mesh,
+    part: &'a Partition,
+    dofs: &'a DofMap,
+    layout: &'a Layout,
     half: bool,
     start: Start,
     attempt: Attempt,
-) -> Result<EhlSolution, Error> {
+) -> Result<(EhlSolution, Kept<'a>), Error> {
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
@@ -408,7 +441,7 @@ fn solve_monolithic(
         milder.as_ref().map(|(m, x)| MilderStart { parameter: m.parameter, ts: m.ts, x, label: m.label }),
     )?;
     let solve_s = t1.elapsed().as_secs_f64();
-    Ok(EhlSolution {
+    let solution = EhlSolution {
         x: out.x,
         report: out.report,
         newton_total: out.newton_total,
@@ -418,5 +451,6 @@ fn solve_monolithic(
         coupling: Coupling::Monolithic,
         continued: out.continued,
         milder: out.milder,
-    })
+    };
+    Ok((solution, Kept { snes: out.snes, jacobian: j, system }))
 }
