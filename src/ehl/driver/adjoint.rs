@@ -134,6 +134,16 @@ impl EhlSolver<'_> {
                 kept.jacobian.assemble()?;
                 let ksp = kept.snes.ksp()?;
                 ksp.krylov_on_present_factor(KRYLOV_RTOL, KRYLOV_MAX_IT)?;
+                // A trial solve (the adjoint of H0): a factorisation too far from the
+                // solution to converge on is replaced by a new LU now, not in the middle
+                // of the marking.
+                let (b, z) = (Vector::new(comm, local)?, Vector::new(comm, local)?);
+                b.set_all(0.0)?;
+                if ctx.rank == 0 {
+                    b.set_values(&[layout.h0], &[1.0], false)?;
+                }
+                b.assemble()?;
+                ksp.solve_transpose(&b, &z)?;
                 Ok(ksp)
             })();
             match solved {
