@@ -32,7 +32,7 @@ use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
 use crate::case::Scene;
 use crate::collective;
-use crate::ehl::driver::{EhlSolution, EhlSolver, Milder, Start};
+use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, Start};
 use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
 use crate::mesh::size_field::SizeField;
@@ -203,10 +203,14 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 // level's pressure. A failure the raise does not answer gets them after all.
                 let raisable = scene.reynolds.gradient_jump > 0.0 && scene.reynolds.gradient_jump < RAISED_GRADIENT_JUMP;
                 let last_resorts = !raisable || full_ladder == Some(k);
-                let solved = collective::agree(
-                    &ctx.world,
-                    solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder, last_resorts }),
-                );
+                // A monolithic level after a monolithic one starts from its displacement.
+                let coarser = (prev.sol.coupling == Coupling::Monolithic).then_some(Coarser {
+                    mesh: &prev.setup.mesh,
+                    layout: &prev.setup.layout,
+                    x: &prev.sol.x,
+                });
+                let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder, last_resorts, coarser };
+                let solved = collective::agree(&ctx.world, solver.solve_from(ctx, scene, start));
                 match solved {
                     Ok(sol) => sol,
                     // A level that does not converge with a small gradient-jump factor is

@@ -150,9 +150,17 @@ pub(super) fn onward<'a>(ctx: &'a Context, scene: &Scene, solver: &EhlSolver<'a>
     let hc = f.stats().hc;
     let label = format!("the failed try's state ({} contact triangles)", setup.mesh.contact_tris.len());
     let Some(r) = reached else {
-        return solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc, label: &label, plain: true, milder: None, last_resorts: true });
+        return solver.solve_from(
+            ctx,
+            scene,
+            Start::Pressure { p: &p, hc, label: &label, plain: true, milder: None, last_resorts: true, coarser: None },
+        );
     };
     let ts = [r.t];
     let milder = Milder { parameter: r.parameter, ts: &ts, p: &p, hc, label: &label };
-    solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc, label: &label, plain: false, milder: Some(milder), last_resorts: false })
+    solver.solve_from(
+        ctx,
+        scene,
+        Start::Pressure { p: &p, hc, label: &label, plain: false, milder: Some(milder), last_resorts: false, coarser: None },
+    )
 }

@@ -155,7 +155,7 @@ impl EarlierRun {
         solver.solve_from(
             ctx,
             scene,
-            crate::ehl::driver::Start::Pressure { p: &p, hc, label: &label, plain: true, milder: None, last_resorts: true },
+            crate::ehl::driver::Start::Pressure { p: &p, hc, label: &label, plain: true, milder: None, last_resorts: true, coarser: None },
         )
     }
 

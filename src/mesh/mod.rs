@@ -26,14 +26,17 @@ mod refine;
 pub mod size_field;
 pub mod spec;
 
+mod walk;
+
 #[cfg(test)]
 mod tests;
 
 use crate::error::Error;
 pub use locate::ContactLocator;
-pub use partition::{equal_blocks, morton3, partition, Partition};
+pub use partition::{equal_blocks, morton3, morton_order, partition, Partition};
 pub use quality::{quality, tet_quality, Quality};
 pub use spec::{MeshSpec, Rect, Ring};
+pub use walk::{tet_barycentric, TetWalk};
 
 /// A P2 tetrahedral mesh of the box with its contact face.
 #[derive(Clone, Debug, PartialEq)]

@@ -22,7 +22,7 @@ pub use diagnostics::{check_jacobian, POLE_COLLAPSE};
 use policy::Attempt;
 pub use policy::{set_newton_defaults, set_newton_linear_solver, Coupling, CONDENSED_PREFIX};
 pub use problem::{lambda_bar, lubricant, velocity_field};
-pub use start::{Milder, Start};
+pub use start::{Coarser, Milder, Start};
 
 use super::condensed::CondensedSystem;
 use super::layout::Layout;
@@ -38,7 +38,7 @@ pub use continuation::ContinuationPath;
 use continuation::{newton_with_continuation, MilderStart};
 use policy::Policy;
 use problem::ehl_params;
-use start::{elastic_start, rigid_start, start_h0};
+use start::{coarser_displacement, elastic_start, rigid_start, start_h0};
 
 /// Result of a converged lubricated solve (dimensionless state gathered on every rank).
 pub struct EhlSolution {
@@ -398,7 +398,28 @@ fn solve_monolithic<'a>(
         Start::Previous(prev) => prev.to_vec(),
         Start::Hertz | Start::Pressure { .. } => {
             let (p, hc) = start.pressure(scene);
-            state_of(p, hc)?
+            match start.coarser().and_then(|c| coarser_displacement(&c, mesh)) {
+                // The coarser level's displacement and the pressure, H0 as from the deflection.
+                Some(u) => {
+                    let mut x0 = vec![0.0; layout.total()];
+                    for (n, un) in u.iter().enumerate() {
+                        for (c, &v) in un.iter().enumerate() {
+                            let g = layout.u[n][c];
+                            if g >= 0 {
+                                x0[g as usize] = v;
+                            }
+                        }
+                        let d = layout.p[n];
+                        if d >= 0 {
+                            let c = mesh.nodes[n];
+                            x0[d as usize] = p(c[0], c[2]);
+                        }
+                    }
+                    x0[layout.h0 as usize] = start_h0(hc, mesh, &|n| layout.uy(&x0, n))?;
+                    x0
+                }
+                None => state_of(p, hc)?,
+            }
         }
     };
     let policy = Policy::for_start(&start, attempt);

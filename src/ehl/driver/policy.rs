@@ -260,7 +260,7 @@ mod tests {
     #[test]
     fn another_meshs_pressure_continues_from_itself_after_a_short_plain_newton() {
         let p = |_: f64, _: f64| 0.0;
-        let coarse = Start::Pressure { p: &p, hc: 0.5, label: "level 0", plain: true, milder: None, last_resorts: true };
+        let coarse = Start::Pressure { p: &p, hc: 0.5, label: "level 0", plain: true, milder: None, last_resorts: true, coarser: None };
         for monolithic in [true, false] {
             let ladder = Attempt::ladder(&coarse, monolithic);
             assert_eq!(ladder.len(), 2);
@@ -273,7 +273,7 @@ mod tests {
             assert!(cont.bt_after_domain_error() && !plain.bt_after_domain_error());
         }
         // After a coarser level that needed the continuation: the continuation at once.
-        let hard = Start::Pressure { p: &p, hc: 0.5, label: "level 1", plain: false, milder: None, last_resorts: true };
+        let hard = Start::Pressure { p: &p, hc: 0.5, label: "level 1", plain: false, milder: None, last_resorts: true, coarser: None };
         assert_eq!(Attempt::ladder(&hard, true), vec![Attempt { reuse_lu: true, continues: true }]);
         assert_eq!(Attempt::ladder(&hard, false), vec![Attempt { reuse_lu: false, continues: true }]);
         // A sweep's previous point: the LU reuse on the monolithic coupling, then exact Newton.
@@ -284,7 +284,7 @@ mod tests {
         let hertz = Policy::for_start(&Start::Hertz, Attempt::PLAIN);
         assert!(hertz.continues && hertz.plain_first && !hertz.reuses_lu && hertz.last_resorts);
         // A caller with a remedy of its own: the continuation without the last resorts.
-        let own = Start::Pressure { p: &p, hc: 0.5, label: "level 2", plain: false, milder: None, last_resorts: false };
+        let own = Start::Pressure { p: &p, hc: 0.5, label: "level 2", plain: false, milder: None, last_resorts: false, coarser: None };
         let ladder = Attempt::ladder(&own, true);
         assert!(ladder.iter().all(|a| !Policy::for_start(&own, *a).last_resorts));
         assert!(!own.last_resorts() && hard.last_resorts());

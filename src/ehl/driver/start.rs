@@ -29,7 +29,26 @@ pub enum Start<'s> {
     /// `last_resorts` false the load and speed continuations and the Hertz start are not
     /// tried after the continuations nearest the scene (tilt, pressure-viscosity) fail:
     /// the caller has a remedy of its own to try first.
-    Pressure { p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str, plain: bool, milder: Option<Milder<'s>>, last_resorts: bool },
+    /// `coarser`: the coarser level's own state, when it was solved on the monolithic
+    /// coupling: its displacement interpolated at this mesh's nodes replaces the elastic
+    /// solve under the pressure on a monolithic level ([`coarser_displacement`]).
+    Pressure {
+        p: &'s dyn Fn(f64, f64) -> f64,
+        hc: f64,
+        label: &'s str,
+        plain: bool,
+        milder: Option<Milder<'s>>,
+        last_resorts: bool,
+        coarser: Option<Coarser<'s>>,
+    },
+}
+
+/// A coarser level's converged monolithic state (U, P and H0 in its layout) on its mesh.
+#[derive(Clone, Copy)]
+pub struct Coarser<'s> {
+    pub mesh: &'s Mesh,
+    pub layout: &'s Layout,
+    pub x: &'s [f64],
 }
 
 /// A coarser level's path through a continuation: the pressure field at `ts[0]` of the
@@ -56,6 +75,14 @@ impl<'s> Start<'s> {
     }
 
     /// A coarser level's state short of the scene, if the start carries one.
+    /// The coarser level's monolithic state, if the start carries one.
+    pub(super) fn coarser(&self) -> Option<Coarser<'s>> {
+        match *self {
+            Start::Pressure { coarser, .. } => coarser,
+            _ => None,
+        }
+    }
+
     pub(super) fn milder(&self) -> Option<Milder<'s>> {
         match *self {
             Start::Pressure { milder, .. } => milder,
@@ -110,6 +137,33 @@ pub(super) fn elastic_start(
     let u = Vector::new(comm, dofs.local(ctx.rank))?;
     Ksp::solve_once_more_with_workspace(comm, k, START_PREFIX, &b, &u)?;
     u.gather_all()
+}
+
+/// The displacement of the coarser state `c` at every node of `mesh` (P2 interpolation in
+/// the coarser mesh's tetrahedra), or None when a node lies outside it. The coarser state
+/// satisfies its own elastic equations; on the finer mesh its residual is the
+/// discretisation's change, which Newton's first step (linear in U) removes. It replaces
+/// an elastic Cholesky of the finer mesh (9 s of table2-ue2's 199,642-unknown level).
+pub(super) fn coarser_displacement(c: &Coarser, mesh: &Mesh) -> Option<Vec<[f64; 3]>> {
+    let walk = crate::mesh::TetWalk::new(c.mesh);
+    let value = |n: u32, k: usize| {
+        let d = c.layout.u[n as usize][k];
+        if d >= 0 {
+            c.x[d as usize]
+        } else {
+            0.0
+        }
+    };
+    let mut u = vec![[0.0; 3]; mesh.nodes.len()];
+    let mut from = 0;
+    for n in crate::mesh::morton_order(mesh) {
+        let (t, l) = walk.locate(c.mesh, mesh.nodes[n as usize], from)?;
+        let tet = &c.mesh.tets[t];
+        let values: [f64; 30] = std::array::from_fn(|i| value(tet[i / 3], i % 3));
+        u[n as usize] = crate::fem::p2tet::p2_tet_eval(&values, l);
+        from = t;
+    }
+    Some(u)
 }
 
 /// Options prefix of the start's elastic solve (`-start_pc_type`, `-start_mat_mumps_icntl_7`).
