@@ -8,7 +8,8 @@
 //!    triangle of the pressurised zone (a nodal pressure above 0.01 p_H). Halve their size,
 //!    keep the others' (a graded size field on the face, [`crate::mesh::size_field`]), and
 //!    mesh the solid anew under it (conforming bisection).
-//! 3. Solve from the previous level's pressure, interpolated (mesh sequencing).
+//! 3. Solve from the previous level's pressure, interpolated (mesh sequencing), and after a
+//!    monolithic level from its displacement too.
 //! 4. Estimate the error of hc and hm (and fx, fz with friction) from the change between
 //!    the last two levels, e_k = |Q_k - Q_{k-1}| max(1, rho/(1 - rho)) with rho the observed
 //!    ratio of the last two changes (capped at 0.8): for a sequence converging by a factor
