@@ -6,7 +6,7 @@
 //! penalty is ramped from [`PENALTY_START`] to the scene's. Every Newton solve is logged and
 //! kept in the path.
 use super::diagnostics::Collapse;
-use super::policy::{set_newton_linear_solver, Policy};
+use super::policy::{newton_atol, set_newton_linear_solver, Policy, INTERMEDIATE_ATOL};
 use super::problem::{lambda_bar, lubricant, penalty, velocity_field};
 use crate::case::Scene;
 use crate::context::Context;
@@ -209,6 +209,13 @@ struct Newton<'a> {
     /// A continuation step stopped at the film's domain is solved again with the "bt"
     /// line search ([`Policy::bt_after_domain_error`]).
     bt_after_domain: bool,
+    /// The scene's cavitation penalty: a solve below it (the staged xi = 1e3) is short of
+    /// the scene.
+    scene_penalty: f64,
+    /// The absolute tolerance of a solve short of the scene (with an accuracy target,
+    /// [`INTERMEDIATE_ATOL`]), and of the scene's own solve.
+    short_atol: Option<f64>,
+    atol: f64,
 }
 
 /// After a MUMPS failure for want of workspace, sets `-mat_mumps_icntl_14` (percentage added
@@ -235,8 +242,22 @@ impl Newton<'_> {
         self.steps.push(s);
     }
 
-    /// One Newton solve of the scene `sc` from `start`.
-    fn solve(&mut self, sc: &Scene, system: &mut dyn EhlProblem, start: &[f64]) -> Result<SolveReport, Error> {
+    /// One Newton solve of the scene `sc` from `start`; `short`: `sc` is short of the
+    /// scene (a continuation step below t = 1, the staged penalty), solved to
+    /// `short_atol` when there is one.
+    fn solve(&mut self, sc: &Scene, system: &mut dyn EhlProblem, start: &[f64], short: bool) -> Result<SolveReport, Error> {
+        let loose = self.short_atol.filter(|_| short);
+        if let Some(atol) = loose {
+            petsc::options::set_ours("-snes_atol", &format!("{atol:e}"))?;
+        }
+        let r = self.solve_to_tolerance(sc, system, start);
+        if loose.is_some() {
+            petsc::options::set_ours("-snes_atol", &format!("{:e}", self.atol))?;
+        }
+        r
+    }
+
+    fn solve_to_tolerance(&mut self, sc: &Scene, system: &mut dyn EhlProblem, start: &[f64]) -> Result<SolveReport, Error> {
         let (lo, hi) = self.owned;
         system.set_operating(lambda_bar(sc), lubricant(sc), penalty(sc));
         self.x.set_local_values(&start[lo..hi])?;
@@ -324,7 +345,8 @@ impl Newton<'_> {
         if p.kinematic() {
             system.set_velocity(velocity_field(&sc));
         }
-        let mut r = self.solve(&sc, system, start)?;
+        let short = t < 1.0 || penalty(&sc) < self.scene_penalty;
+        let mut r = self.solve(&sc, system, start, short)?;
         if self.bt_after_domain && r.reason.starts_with("DIVERGED_FUNCTION_DOMAIN") {
             self.iterations += r.iterations;
             self.note(format!(
@@ -335,7 +357,7 @@ impl Newton<'_> {
                 r.iterations
             ));
             petsc::options::set_ours("-snes_linesearch_type", "bt")?;
-            let again = self.solve(&sc, system, start);
+            let again = self.solve(&sc, system, start, short);
             petsc::options::set_ours("-snes_linesearch_type", "l2")?;
             r = again?;
         }
@@ -468,6 +490,9 @@ pub(super) fn newton_with_continuation(
         iterations: 0,
         bt_after_domain: policy.bt_after_domain_error(),
         reuses_lu: policy.reuses_lu,
+        scene_penalty: penalty(scene),
+        short_atol: (scene.accuracy.target > 0.0).then_some(INTERMEDIATE_ATOL.max(newton_atol(scene.accuracy.target))),
+        atol: newton_atol(scene.accuracy.target),
     };
     // The problem solved first. A stiff cavitation penalty (xi > 1e3) is reached last, from
     // the solution at xi = 1e3: on fine rings Newton crawls at xi = 1e4 from the Hertz start
@@ -490,7 +515,7 @@ pub(super) fn newton_with_continuation(
     let mut last: Option<SolveReport> = None;
     let mut state: Option<Vec<f64>> = None;
     if policy.plain_first && !opts.skip_plain {
-        let report = nw.solve(&base, system, x0)?;
+        let report = nw.solve(&base, system, x0, staged)?;
         let at_xi = if staged { format!(", xi = {PENALTY_START:e}") } else { String::new() };
         nw.note(format!("Newton from {label} at L = {target} N{at_xi}: {} ({} iterations)", report.reason, report.iterations));
         nw.iterations = report.iterations;
