@@ -39,7 +39,7 @@ pub const ADJOINT_PREFIX: &str = "adjoint_";
 /// difference is exact to O(1e-8) and the roundoff of F(x) ~ 0 stays near 1e-12 of dF/ds.
 const SPEED_STEP: f64 = 1e-4;
 
-/// The adjoints of film values at a converged state, from one LU. Collective in every
+/// The adjoints of film values at a converged state, from one factorisation. Collective in every
 /// method. An adjoint z is in the layout of the system it was solved on (monolithic, or
 /// condensed: P and H0); [`Adjoint::pressure_part`] reads it per mesh node, and
 /// [`film_derivative`] pairs it with [`Adjoint::residual_speed_derivative`] of the same
@@ -92,8 +92,10 @@ enum Form<'a> {
 
 impl EhlSolver<'_> {
     /// The adjoint machinery at the converged state `x` (monolithic layout,
-    /// [`super::EhlSolution::x`]): on the coupling the level was solved with, the Jacobian
-    /// assembled and factorised once (prefix `adjoint_`). Collective.
+    /// [`super::EhlSolution::x`]), on the coupling the level was solved with: the condensed
+    /// Jacobian transposed and factorised; on the monolithic coupling Newton's own solver
+    /// when it was kept ([`EhlSolver::keep_newton`]), else the Jacobian factorised (prefix
+    /// `adjoint_`). Collective.
     pub fn adjoint<'s>(&'s self, ctx: &'s Context, scene: &Scene, x: &'s [f64]) -> Result<Adjoint<'s>, Error> {
         let (mesh, layout) = (self.mesh, self.layout);
         let comm = petsc::comm_world();

@@ -257,6 +257,8 @@ impl Newton<'_> {
         r
     }
 
+    /// [`Newton::solve`] at the tolerance set: the linear-solver retries and the exact
+    /// finish after a stale LU included.
     fn solve_to_tolerance(&mut self, sc: &Scene, system: &mut dyn EhlProblem, start: &[f64]) -> Result<SolveReport, Error> {
         let (lo, hi) = self.owned;
         system.set_operating(lambda_bar(sc), lubricant(sc), penalty(sc));

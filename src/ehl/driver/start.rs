@@ -74,7 +74,6 @@ impl<'s> Start<'s> {
         }
     }
 
-    /// A coarser level's state short of the scene, if the start carries one.
     /// The coarser level's monolithic state, if the start carries one.
     pub(super) fn coarser(&self) -> Option<Coarser<'s>> {
         match *self {
@@ -83,6 +82,7 @@ impl<'s> Start<'s> {
         }
     }
 
+    /// A coarser level's state short of the scene, if the start carries one.
     pub(super) fn milder(&self) -> Option<Milder<'s>> {
         match *self {
             Start::Pressure { milder, .. } => milder,
