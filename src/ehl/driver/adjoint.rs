@@ -103,22 +103,9 @@ impl EhlSolver<'_> {
         let params = ehl_params(scene, eq.nu, self.half);
         if let Some(comp) = &self.comp {
             let mut system = CondensedSystem::new(mesh, comp, ctx.size, ctx.rank, params, lubricant(scene));
-            let cl = system.layout.clone();
-            let mut xc = vec![0.0; cl.total()];
-            for (j, &n) in comp.cols.iter().enumerate() {
-                xc[j] = x[layout.p[n as usize] as usize];
-            }
-            xc[cl.h0()] = x[layout.h0 as usize];
-            let (d_nnz, o_nnz) = system.preallocation();
-            let local = cl.local(ctx.rank);
-            let j = if comp.is_rigid() {
-                Matrix::new_aij(comm, local, &d_nnz, &o_nnz)?
-            } else {
-                let j = Matrix::new_dense(comm, local, super::CONDENSED_PREFIX, &d_nnz, &o_nnz)?;
-                let (rows, cols) = j.dense_fill_block(cl.total())?;
-                system.set_fill_block(rows, cols);
-                j
-            };
+            let xc = super::condensed_state(comp, &system.layout, layout, x);
+            let local = system.layout.local(ctx.rank);
+            let j = super::condensed_jacobian(&mut system, ctx.rank)?;
             system.jacobian(&xc, &j)?;
             j.assemble()?;
             // ScaLAPACK's LU has no transposed solve: the transpose is factorised instead.

@@ -240,7 +240,6 @@ fn solve_condensed(
     start: Start,
     attempt: Attempt,
 ) -> Result<EhlSolution, Error> {
-    let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
     let mut system = CondensedSystem::new(mesh, comp, ctx.size, ctx.rank, ehl_params(scene, eq.nu, half), lubricant(scene));
@@ -261,10 +260,7 @@ fn solve_condensed(
     let mut x0 = vec![0.0; cl.total()];
     let label = match start {
         Start::Previous(prev) => {
-            for (j, &n) in comp.cols.iter().enumerate() {
-                x0[j] = prev[layout.p[n as usize] as usize];
-            }
-            x0[cl.h0()] = prev[layout.h0 as usize];
+            x0 = condensed_state(comp, &cl, layout, prev);
             start.label()
         }
         Start::Hertz | Start::Pressure { .. } => {
@@ -279,15 +275,7 @@ fn solve_condensed(
             }
         }
     };
-    let (d_nnz, o_nnz) = system.preallocation();
-    let j = if comp.is_rigid() {
-        Matrix::new_aij(comm, cl.local(ctx.rank), &d_nnz, &o_nnz)?
-    } else {
-        let j = Matrix::new_dense(comm, cl.local(ctx.rank), CONDENSED_PREFIX, &d_nnz, &o_nnz)?;
-        let (rows, cols) = j.dense_fill_block(cl.total())?;
-        system.set_fill_block(rows, cols);
-        j
-    };
+    let j = condensed_jacobian(&mut system, ctx.rank)?;
     petsc::ksp::set_direct_solver_defaults_for("", &j)?;
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
@@ -355,6 +343,36 @@ fn solve_condensed(
     })
 }
 
+/// The condensed state (P in `comp.cols` order, then H0) of a monolithic state `x`.
+fn condensed_state(
+    comp: &crate::solid::condense::Compliance,
+    cl: &super::condensed::CondensedLayout,
+    layout: &Layout,
+    x: &[f64],
+) -> Vec<f64> {
+    let mut xc = vec![0.0; cl.total()];
+    for (j, &n) in comp.cols.iter().enumerate() {
+        xc[j] = x[layout.p[n as usize] as usize];
+    }
+    xc[cl.h0()] = x[layout.h0 as usize];
+    xc
+}
+
+/// The matrix of the condensed Jacobian of `system` on this rank: dense (the block of it
+/// this rank fills is set on the system), or sparse with rigid solids.
+fn condensed_jacobian(system: &mut CondensedSystem, rank: usize) -> Result<Matrix, Error> {
+    let comm = petsc::comm_world();
+    let (d_nnz, o_nnz) = system.preallocation();
+    let local = system.layout.local(rank);
+    if system.comp.is_rigid() {
+        return Ok(Matrix::new_aij(comm, local, &d_nnz, &o_nnz)?);
+    }
+    let j = Matrix::new_dense(comm, local, CONDENSED_PREFIX, &d_nnz, &o_nnz)?;
+    let (rows, cols) = j.dense_fill_block(system.layout.total())?;
+    system.set_fill_block(rows, cols);
+    Ok(j)
+}
+
 /// The monolithic path: U, P and H0 in one sparse system, from the Hertz start or from a
 /// previous state `start` (same layout). Returns the solution and its Newton solver.
 #[allow(clippy::too_many_arguments)]
@@ -373,16 +391,30 @@ fn solve_monolithic<'a>(
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
     let k = assembly::assemble_stiffness(comm, mesh, part, dofs, ctx.rank, eq.nu)?;
-    // Initial iterate of a pressure field and central film: the pressure, its
-    // displacement, H0 from the central film.
-    let state_of = |p: &dyn Fn(f64, f64) -> f64, hc: f64| -> Result<Vec<f64>, Error> {
-        let u_dry = elastic_start(comm, ctx, mesh, part, dofs, &k, eq.nu, p)?;
+    // Initial iterate of a pressure field and central film: the pressure, its displacement
+    // (the coarser level's `u`, interpolated, when given; else solved under the pressure),
+    // H0 from the central film.
+    let state_of = |p: &dyn Fn(f64, f64) -> f64, hc: f64, u: Option<Vec<[f64; 3]>>| -> Result<Vec<f64>, Error> {
+        let u_at: Box<dyn Fn(usize, usize) -> f64> = match u {
+            Some(u) => Box::new(move |n, c| u[n][c]),
+            None => {
+                let u_dry = elastic_start(comm, ctx, mesh, part, dofs, &k, eq.nu, p)?;
+                Box::new(move |n, c| {
+                    let d = dofs.node_dof[n][c];
+                    if d >= 0 {
+                        u_dry[d as usize]
+                    } else {
+                        0.0
+                    }
+                })
+            }
+        };
         let mut x0 = vec![0.0; layout.total()];
         for n in 0..mesh.nodes.len() {
             for c in 0..3 {
-                let (d, g) = (dofs.node_dof[n][c], layout.u[n][c]);
-                if d >= 0 {
-                    x0[g as usize] = u_dry[d as usize];
+                let g = layout.u[n][c];
+                if g >= 0 {
+                    x0[g as usize] = u_at(n, c);
                 }
             }
             let d = layout.p[n];
@@ -398,33 +430,12 @@ fn solve_monolithic<'a>(
         Start::Previous(prev) => prev.to_vec(),
         Start::Hertz | Start::Pressure { .. } => {
             let (p, hc) = start.pressure(scene);
-            match start.coarser().and_then(|c| coarser_displacement(&c, mesh)) {
-                // The coarser level's displacement and the pressure, H0 as from the deflection.
-                Some(u) => {
-                    let mut x0 = vec![0.0; layout.total()];
-                    for (n, un) in u.iter().enumerate() {
-                        for (c, &v) in un.iter().enumerate() {
-                            let g = layout.u[n][c];
-                            if g >= 0 {
-                                x0[g as usize] = v;
-                            }
-                        }
-                        let d = layout.p[n];
-                        if d >= 0 {
-                            let c = mesh.nodes[n];
-                            x0[d as usize] = p(c[0], c[2]);
-                        }
-                    }
-                    x0[layout.h0 as usize] = start_h0(hc, mesh, &|n| layout.uy(&x0, n))?;
-                    x0
-                }
-                None => state_of(p, hc)?,
-            }
+            state_of(p, hc, start.coarser().and_then(|c| coarser_displacement(&c, mesh)))?
         }
     };
     let policy = Policy::for_start(&start, attempt);
     let milder = match start.milder().filter(|_| policy.continues) {
-        Some(m) => Some((m, state_of(m.p, m.hc)?)),
+        Some(m) => Some((m, state_of(m.p, m.hc, None)?)),
         None => None,
     };
     let label = start.label();
