@@ -18,6 +18,12 @@ const RHO_CAP: f64 = 0.8;
 /// change that crossed the limit by chance.
 const FASTEST_CONTRACTION: f64 = 0.125;
 
+/// A level cut to the budget whose triangles carry at least this share of its marked
+/// indicator is estimated as a full level: it refined the triangles that carry
+/// `accuracy.marking` times this share of the whole indicator (0.81 at the default 0.9), a
+/// Doerfler marking of its own, not part of one.
+pub const FULL_LEVEL_SHARE: f64 = 0.9;
+
 /// The estimated relative errors of a level's target quantities: hc and hm, and with
 /// friction fx and fz, each relative to the magnitude of the friction coefficient
 /// sqrt(fx^2 + fz^2) (fz vanishes by symmetry without spin, so its own size is no scale).
@@ -32,8 +38,9 @@ impl Estimate {
     /// The estimate of the last level of `levels`, None before the second level.
     pub(super) fn of(levels: &[Level]) -> Option<Estimate> {
         // A level cut to the budget refined part of what its marking asked for: its change
-        // is not one of a sequence, so the estimate before it is carried over instead.
-        let cut = levels.last().is_some_and(|l| l.budget_share.is_some());
+        // is not one of a sequence, so the estimate before it is carried over instead. A cut
+        // that kept nearly all of it is a level of the sequence ([`FULL_LEVEL_SHARE`]).
+        let cut = levels.last().is_some_and(|l| l.budget_share.is_some_and(|s| s < FULL_LEVEL_SHARE));
         let e = sequences(levels)
             .iter()
             .map(|(q, scale)| if cut { estimate_after_cut(q, *scale) } else { estimate_scaled(q, *scale) })
@@ -272,6 +279,38 @@ mod tests {
         let mut c = q.clone();
         c.push(q[3] + towards);
         assert!((estimate_after_cut(&c, 1.0).unwrap() - 0.7 * before).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_cut_level_that_kept_nearly_all_its_marking_is_a_level_of_the_sequence() {
+        let level = |hm: f64, share: Option<f64>| Level {
+            elastic_unknowns: 0,
+            pressure_unknowns: 0,
+            contact_triangles: 0,
+            min_size: 0.25,
+            newton_iterations: 0,
+            seconds: 0.0,
+            failed_seconds: 0.0,
+            hc: 1.0,
+            hm,
+            hm_at: [0.0, -0.9],
+            pmax: 1.0,
+            friction: None,
+            est: None,
+            budget_share: share,
+        };
+        // table2-ue2's hm over five levels, the last cut to the budget.
+        let hm = [0.14461, 0.13818, 0.13869, 0.13790, 0.13779];
+        let with = |share: Option<f64>| {
+            let mut l: Vec<Level> = hm.iter().map(|&v| level(v, None)).collect();
+            l[4].budget_share = share;
+            Estimate::of(&l).unwrap().hm
+        };
+        let q = hm.to_vec();
+        assert_eq!(with(Some(0.95)), estimate_scaled(&q, hm[4]).unwrap());
+        assert_eq!(with(Some(0.6)), estimate_after_cut(&q, hm[4]).unwrap());
+        // The full-level rule trusts rho = 0.14 there; the carried estimate does not.
+        assert!(with(Some(0.95)) < 0.001 && with(Some(0.6)) > 0.005);
     }
 
     #[test]
