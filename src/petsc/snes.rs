@@ -67,6 +67,56 @@ pub struct Snes {
     /// their linear iteration counts.
     history: Vec<ffi::PetscReal>,
     history_its: Vec<ffi::PetscInt>,
+    /// The stall test's state (boxed: PETSc holds its address), when one is set.
+    stall: Option<Box<StallTest>>,
+}
+
+/// A solve stops as stalled when its smallest residual norm over the last `window`
+/// iterations is above `factor` times the smallest before them ([`stalled`]).
+struct StallTest {
+    window: usize,
+    factor: f64,
+    norms: Vec<f64>,
+    stalled: bool,
+}
+
+/// Whether the residual norms `norms` (one per iteration, the start first) have stalled:
+/// the smallest of the last `window` is above `factor` times the smallest before them.
+pub fn stalled(norms: &[f64], window: usize, factor: f64) -> bool {
+    let n = norms.len();
+    if window == 0 || n <= window {
+        return false;
+    }
+    let least = |v: &[f64]| v.iter().cloned().fold(f64::INFINITY, f64::min);
+    least(&norms[n - window..]) > factor * least(&norms[..n - window])
+}
+
+/// PETSc's default convergence test, then the stall test of [`stalled`].
+unsafe extern "C" fn converged_or_stalled(
+    snes: ffi::SNES,
+    it: ffi::PetscInt,
+    xnorm: ffi::PetscReal,
+    snorm: ffi::PetscReal,
+    fnorm: ffi::PetscReal,
+    reason: *mut ffi::SNESConvergedReason,
+    ctx: *mut c_void,
+) -> ffi::PetscErrorCode {
+    let code = ffi::SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, std::ptr::null_mut());
+    if code != 0 {
+        return code;
+    }
+    let t = &mut *(ctx as *mut StallTest);
+    if it == 0 {
+        t.norms.clear();
+        t.stalled = false;
+    }
+    t.norms.push(fnorm);
+    if *reason == ffi::SNESConvergedReason_SNES_CONVERGED_ITERATING && stalled(&t.norms, t.window, t.factor) {
+        // Out of useful iterations, as at the iteration budget: callers treat both alike.
+        *reason = ffi::SNESConvergedReason_SNES_DIVERGED_MAX_IT;
+        t.stalled = true;
+    }
+    0
 }
 
 /// Residual norms kept of one solve (more than any Newton iteration budget used).
@@ -172,7 +222,7 @@ impl Snes {
     pub fn new(comm: ffi::MPI_Comm, prefix: &str) -> Result<Snes> {
         let mut raw: ffi::SNES = std::ptr::null_mut();
         pcall!(ffi::SNESCreate(comm, &mut raw))?;
-        let mut s = Snes { raw, history: vec![0.0; HISTORY], history_its: vec![0; HISTORY] };
+        let mut s = Snes { raw, history: vec![0.0; HISTORY], history_its: vec![0; HISTORY], stall: None };
         // The buffers live as long as the SNES, which writes into them on every solve.
         pcall!(ffi::SNESSetConvergenceHistory(
             s.raw,
@@ -186,6 +236,22 @@ impl Snes {
             pcall!(ffi::SNESSetOptionsPrefix(s.raw, p.as_ptr()))?;
         }
         Ok(s)
+    }
+
+    /// Stops a solve as stalled (reason DIVERGED_MAX_IT, "stalled" in its report) when its
+    /// smallest residual norm over the last `window` iterations is above `factor` times the
+    /// smallest before them ([`stalled`]); `window` 0 removes the test.
+    pub fn set_stall_test(&mut self, window: usize, factor: f64) -> Result<()> {
+        if window == 0 {
+            pcall!(ffi::SNESSetConvergenceTest(self.raw, Some(ffi::SNESConvergedDefault), std::ptr::null_mut(), None))?;
+            self.stall = None;
+            return Ok(());
+        }
+        let mut t = Box::new(StallTest { window, factor, norms: Vec::new(), stalled: false });
+        let ctx = t.as_mut() as *mut StallTest as *mut c_void;
+        pcall!(ffi::SNESSetConvergenceTest(self.raw, Some(converged_or_stalled), ctx, None))?;
+        self.stall = Some(t);
+        Ok(())
     }
 
     /// Solves F(x) = 0 from the initial guess in `x`, with Jacobian storage `j`.
@@ -213,7 +279,14 @@ impl Snes {
         pcall!(ffi::SNESGetConvergedReason(self.raw, &mut reason))?;
         let mut s: *const std::os::raw::c_char = std::ptr::null();
         pcall!(ffi::SNESGetConvergedReasonString(self.raw, &mut s))?;
-        let reason_name = if s.is_null() { reason.to_string() } else { unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned() };
+        let mut reason_name = if s.is_null() { reason.to_string() } else { unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned() };
+        if let Some(t) = self.stall.as_ref().filter(|t| t.stalled) {
+            reason_name = format!(
+                "{reason_name}: stalled (the residual norm fell by less than {:.0} % in {} iterations)",
+                100.0 * (1.0 - t.factor),
+                t.window
+            );
+        }
         let (mut its, mut lits): (ffi::PetscInt, ffi::PetscInt) = (0, 0);
         pcall!(ffi::SNESGetIterationNumber(self.raw, &mut its))?;
         pcall!(ffi::SNESGetLinearSolveIterations(self.raw, &mut lits))?;
@@ -260,5 +333,27 @@ impl Snes {
 impl Drop for Snes {
     fn drop(&mut self) {
         unsafe { ffi::SNESDestroy(&mut self.raw) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::stalled;
+
+    #[test]
+    fn a_plateau_stalls_and_a_slow_descent_does_not() {
+        // M = 1000, L = 10 at 0.0078 a: the alpha step that failed after 30 iterations
+        // (its first 14 residual norms) stalls at iteration 13; the step that converged in
+        // 21 iterations on the level before never does.
+        let failed = [0.2258, 0.1802, 0.1774, 0.1489, 0.1507, 0.1511, 0.1459, 0.1740, 0.1787, 0.1806, 0.1752, 0.1720, 0.1632, 0.2150];
+        let first = (1..=failed.len()).find(|&n| stalled(&failed[..n], 10, 0.9));
+        assert_eq!(first, Some(14));
+        let slow = [
+            0.2660, 0.2410, 0.2189, 0.2143, 0.1577, 0.1483, 0.1341, 0.1006, 0.0936, 0.0906, 0.0683, 0.0535, 0.0450, 0.0234, 0.0162, 0.0126,
+            1.97e-3, 1.36e-3, 8.75e-4, 5.67e-5, 6.68e-6, 1.24e-7,
+        ];
+        assert!((1..=slow.len()).all(|n| !stalled(&slow[..n], 10, 0.9)));
+        // Too few iterations to judge, or the test off.
+        assert!(!stalled(&failed[..10], 10, 0.9) && !stalled(&failed, 0, 0.9));
     }
 }

@@ -280,7 +280,7 @@ impl Newton<'_> {
             let more = more_mumps_workspace(&why)?;
             self.note(format!("Newton: {} after {} iterations ({why}); again with a new linear solver{more}", r.reason, r.iterations));
             self.iterations += r.iterations;
-            self.snes = Snes::new(petsc::comm_world(), "")?;
+            self.snes = new_snes(petsc::comm_world())?;
             self.x.set_local_values(&start[lo..hi])?;
             system.take_collapse();
             r = self.snes.solve(system, &self.x, self.j)?;
@@ -481,7 +481,7 @@ pub(super) fn newton_with_continuation(
     let opts = crate::ehl_options::get();
     let mut nw = Newton {
         ctx,
-        snes: Snes::new(comm, "")?,
+        snes: new_snes(comm)?,
         x: Vector::new(comm, local)?,
         j,
         owned,
@@ -618,6 +618,13 @@ pub(super) fn newton_with_continuation(
     };
     let last = last.clone();
     Ok(NewtonOutcome { x: xs, report: last, newton_total: nw.iterations, steps: nw.steps, continued, milder: reached_from, snes: nw.snes })
+}
+
+/// Newton's solver, with the stall test of `-ehl_newton_stall` ([`crate::ehl_options::NEWTON_STALL`]).
+fn new_snes(comm: petsc::ffi::MPI_Comm) -> Result<Snes, Error> {
+    let mut snes = Snes::new(comm, "")?;
+    snes.set_stall_test(crate::ehl_options::get().newton_stall, super::policy::STALL_FACTOR)?;
+    Ok(snes)
 }
 
 #[cfg(test)]
