@@ -33,8 +33,9 @@ pub struct EhlOptions {
     pub fail_point: Option<usize>,
     /// `-ehl_plot_font FILE`: TrueType font for the plots.
     pub plot_font: Option<String>,
-    /// `-ehl_newton_stall N`: a Newton solve whose smallest residual norm fell by less than
-    /// 10 % over its last N iterations stops as stalled (0: never).
+    /// `-ehl_newton_stall N`: a Newton solve whose smallest residual norm over its last N
+    /// iterations stays above [`NEWTON_STALL_FACTOR`] times the smallest before them stops
+    /// as stalled (0: never).
     pub newton_stall: usize,
 }
 
@@ -62,6 +63,11 @@ impl Default for EhlOptions {
 /// on that run (23, up to 21 iterations, the slow ones gaining 10-30 % per iteration while
 /// the line search damps the steps) passes it.
 pub const NEWTON_STALL: usize = 10;
+
+/// The least decrease of Newton's smallest residual norm over the iterations of
+/// `-ehl_newton_stall` before a solve stops as stalled: its norm must fall below this
+/// factor times the smallest before them.
+pub const NEWTON_STALL_FACTOR: f64 = 0.9;
 
 static OPTIONS: OnceLock<EhlOptions> = OnceLock::new();
 
@@ -101,7 +107,10 @@ pub fn read(comm: petsc::ffi::MPI_Comm) -> petsc::Result<&'static EhlOptions> {
     let newton_stall = g
         .int(
             "-ehl_newton_stall",
-            "Stop a Newton solve whose smallest residual norm fell by less than 10 % over its last N iterations (0: never)",
+            &format!(
+                "Stop a Newton solve whose smallest residual norm fell by less than {:.0} % over its last N iterations (0: never)",
+                100.0 * (1.0 - NEWTON_STALL_FACTOR)
+            ),
             d.newton_stall as i32,
         )?
         .map_or(d.newton_stall, |n| n.max(0) as usize);

@@ -178,6 +178,26 @@ fn estimate_after_cut(q: &[f64], scale: f64) -> Option<f64> {
 mod tests {
     use super::*;
 
+    /// A level with films `hc`, `hm` and friction `friction`, the rest unused by the estimate.
+    fn level(hc: f64, hm: f64, friction: Option<[f64; 2]>) -> Level {
+        Level {
+            elastic_unknowns: 0,
+            pressure_unknowns: 0,
+            contact_triangles: 0,
+            min_size: 0.25,
+            newton_iterations: 0,
+            seconds: 0.0,
+            failed_seconds: 0.0,
+            hc,
+            hm,
+            hm_at: [0.0, -0.9],
+            pmax: 1.0,
+            friction,
+            est: None,
+            budget_share: None,
+        }
+    }
+
     #[test]
     fn the_estimate_of_a_geometric_sequence_bounds_its_error() {
         // q_k = 1 + 0.1 rho^k converges to 1; the estimate of the last value's relative
@@ -220,33 +240,17 @@ mod tests {
 
     #[test]
     fn friction_errors_are_relative_to_the_friction_coefficient_and_join_the_targets() {
-        let level = |hc: f64, f: Option<[f64; 2]>| Level {
-            elastic_unknowns: 0,
-            pressure_unknowns: 0,
-            contact_triangles: 0,
-            min_size: 0.25,
-            newton_iterations: 0,
-            seconds: 0.0,
-            failed_seconds: 0.0,
-            hc,
-            hm: 1.0,
-            hm_at: [0.0, -0.9],
-            pmax: 1.0,
-            friction: f,
-            est: None,
-            budget_share: None,
-        };
         // fz is zero up to round-off (no spin): its change is measured against |f|, not |fz|.
-        let levels = [level(1.0, Some([0.03, 1e-12])), level(1.0, Some([0.0303, 3e-12]))];
+        let levels = [level(1.0, 1.0, Some([0.03, 1e-12])), level(1.0, 1.0, Some([0.0303, 3e-12]))];
         let e = Estimate::of(&levels).unwrap();
         let [fx, fz] = e.friction.unwrap();
         assert!((fx - 0.0003 / 0.0303).abs() < 1e-12 && fz < 1e-9, "{e:?}");
         assert_eq!(e.values().len(), 4);
         assert!(e.describe().contains("fx 0.99 %"), "{}", e.describe());
         // Without friction only hc and hm.
-        let e = Estimate::of(&[level(1.0, None), level(1.02, None)]).unwrap();
+        let e = Estimate::of(&[level(1.0, 1.0, None), level(1.02, 1.0, None)]).unwrap();
         assert_eq!((e.values().len(), e.friction), (2, None));
-        assert!(Estimate::of(&[level(1.0, None)]).is_none());
+        assert!(Estimate::of(&[level(1.0, 1.0, None)]).is_none());
     }
 
     #[test]
@@ -283,26 +287,10 @@ mod tests {
 
     #[test]
     fn a_cut_level_that_kept_nearly_all_its_marking_is_a_level_of_the_sequence() {
-        let level = |hm: f64, share: Option<f64>| Level {
-            elastic_unknowns: 0,
-            pressure_unknowns: 0,
-            contact_triangles: 0,
-            min_size: 0.25,
-            newton_iterations: 0,
-            seconds: 0.0,
-            failed_seconds: 0.0,
-            hc: 1.0,
-            hm,
-            hm_at: [0.0, -0.9],
-            pmax: 1.0,
-            friction: None,
-            est: None,
-            budget_share: share,
-        };
         // table2-ue2's hm over five levels, the last cut to the budget.
         let hm = [0.14461, 0.13818, 0.13869, 0.13790, 0.13779];
         let with = |share: Option<f64>| {
-            let mut l: Vec<Level> = hm.iter().map(|&v| level(v, None)).collect();
+            let mut l: Vec<Level> = hm.iter().map(|&v| level(1.0, v, None)).collect();
             l[4].budget_share = share;
             Estimate::of(&l).unwrap().hm
         };

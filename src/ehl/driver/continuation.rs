@@ -623,7 +623,7 @@ pub(super) fn newton_with_continuation(
 /// Newton's solver, with the stall test of `-ehl_newton_stall` ([`crate::ehl_options::NEWTON_STALL`]).
 fn new_snes(comm: petsc::ffi::MPI_Comm) -> Result<Snes, Error> {
     let mut snes = Snes::new(comm, "")?;
-    snes.set_stall_test(crate::ehl_options::get().newton_stall, super::policy::STALL_FACTOR)?;
+    snes.set_stall_test(crate::ehl_options::get().newton_stall, crate::ehl_options::NEWTON_STALL_FACTOR)?;
     Ok(snes)
 }
 

@@ -125,11 +125,6 @@ impl Policy {
 /// 25-27 on the hard cases' hand-made refinements (docs/hard-cases.md), so it keeps 30.
 pub(super) const MAX_IT: usize = 30;
 
-/// The least decrease of Newton's smallest residual norm over the iterations of
-/// `-ehl_newton_stall` ([`crate::ehl_options::NEWTON_STALL`]) before a solve stops as
-/// stalled.
-pub const STALL_FACTOR: f64 = 0.9;
-
 /// One way of solving from a start: [`super::EhlSolver::solve_from`] tries the attempts of
 /// [`Attempt::ladder`] in order and then the Hertz start.
 #[derive(Clone, Copy, Debug, PartialEq)]
