@@ -123,6 +123,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     let mut tried_s = 0.0;
     // Where a failed first level got, with its mesh: the retry goes on from there ([`onward`]).
     let mut from: Option<Onward> = None;
+    // Where the continuation of a level that failed before the raise of the gradient-jump
+    // factor got, on the level's mesh: its solve with the factor raised goes on from there.
+    let mut raised_from: Option<Reached> = None;
     // How many of its marked triangles the present level refines when all of them would
     // exceed the budget, with the share of the indicator they carry, and the meshes tried
     // for it that were over the budget (count, unknowns).
@@ -211,6 +214,36 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     x: &prev.sol.x,
                 });
                 let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder, last_resorts, coarser };
+                // After the raise: first from the failed try's furthest state (its milder
+                // problem, on this same mesh), without the last resorts; if that fails, from
+                // the coarser level's state as before. At M = 1000, L = 20 the try with
+                // c_J = 0.01 got to alpha = 48.3 of 68.3 GPa^-1 on the 0.0156 a level, and
+                // the raised solve spent 146 s getting there again from the coarser level's
+                // alpha/4; at M = 20, L = 20 the raised ramp from the try's 44.3 GPa^-1
+                // failed at 64.7 -> 68.3, where the one from the coarser level's alpha/2
+                // converges (docs/accuracy.md).
+                let onward_state = raised_from.take();
+                let of = onward_state.as_ref().map(|r| FieldsOnFace::new(&setup.mesh, &setup.layout, &r.x));
+                let po = |x: f64, z: f64| of.as_ref().and_then(|f| f.at(x, z)).map_or(0.0, |v| v.0);
+                let onward_label = format!("level {k}'s state where its try before the raise stopped");
+                let onward_ts = onward_state.as_ref().map_or(vec![], |r| vec![r.t]);
+                let start = match (&onward_state, &of) {
+                    (Some(r), Some(f)) => {
+                        let hc = f.stats().hc;
+                        let milder = Milder { parameter: r.parameter, ts: &onward_ts, p: &po, hc, label: &onward_label };
+                        let here = Coarser { mesh: &setup.mesh, layout: &setup.layout, x: &r.x };
+                        Start::Pressure {
+                            p: &po,
+                            hc,
+                            label: &onward_label,
+                            plain: false,
+                            milder: Some(milder),
+                            last_resorts: false,
+                            coarser: Some(here),
+                        }
+                    }
+                    _ => start,
+                };
                 let solved = collective::agree(&ctx.world, solver.solve_from(ctx, scene, start));
                 match solved {
                     Ok(sol) => sol,
@@ -227,8 +260,19 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                             reason(&e),
                             scene.reynolds.gradient_jump
                         ));
+                        raised_from = reached(ctx, &e);
                         drop(solver);
                         own.reynolds.gradient_jump = RAISED_GRADIENT_JUMP;
+                        tried_s += t0.elapsed().as_secs_f64();
+                        continue;
+                    }
+                    Err(e) if crate::interrupt::agreed() == 0 && onward_state.is_some() && newton_failed(ctx, &e) => {
+                        ctx.log(format!(
+                            "accuracy: level {k} did not converge from its try's state ({}); again from level {}'s state",
+                            reason(&e),
+                            k - 1
+                        ));
+                        drop(solver);
                         tried_s += t0.elapsed().as_secs_f64();
                         continue;
                     }
@@ -460,7 +504,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
 fn newton_failed(ctx: &Context, e: &Error) -> bool {
     collective::all(
         &ctx.world,
-        matches!(e.root(), Error::NotConverged(_) | Error::FilmClosed { .. }) && !e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE),
+        matches!(e.root(), Error::NotConverged { .. } | Error::FilmClosed { .. })
+            && !e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE),
     )
 }
 

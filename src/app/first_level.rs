@@ -111,10 +111,7 @@ pub(super) fn closures(ctx: &Context, e: &Error) -> Vec<[f64; 2]> {
 /// the same on every rank (each rank gathered the same state; rank 0's is taken so that a
 /// rank that failed otherwise cannot disagree). Collective.
 pub(super) fn reached(ctx: &Context, e: &Error) -> Option<Reached> {
-    let local = match e.root() {
-        Error::FilmClosed { reached: Some(r), .. } => Some(r.as_ref()),
-        _ => None,
-    };
+    let local = e.reached();
     let t = collective::from_rank0(&ctx.world, &local.map_or(vec![], |r| vec![r.t]));
     let x = collective::from_rank0(&ctx.world, local.map_or(&[][..], |r| &r.x));
     let parameter = local.map_or("", |r| r.parameter);

@@ -260,7 +260,7 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
     }
     let ok = rows.iter().filter(|r| r.failed.is_none()).count();
     if ok < 2 {
-        return Err(Error::NotConverged(format!("convergence study: only {ok} of {levels} levels converged; nothing to compare")));
+        return Err(Error::not_converged(format!("convergence study: only {ok} of {levels} levels converged; nothing to compare")));
     }
     if ctx.rank == 0 {
         write_outputs(ctx, scene, &rows, sequence)?;

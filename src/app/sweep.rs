@@ -50,11 +50,8 @@ pub fn run<'a>(ctx: &'a Context, scene: &Scene, setup: &Setup, solver: &EhlSolve
         // Test hook (fault injection): -ehl_fail_point k makes point k fail as a
         // non-converged Newton would, to test that the sweep goes on and ends non-zero.
         let injected = crate::ehl_options::get().fail_point == Some(k + 1);
-        let solved = if injected {
-            Err(Error::NotConverged("injected failure (-ehl_fail_point)".into()))
-        } else {
-            solver.solve(ctx, p, prev.as_deref())
-        };
+        let solved =
+            if injected { Err(Error::not_converged("injected failure (-ehl_fail_point)")) } else { solver.solve(ctx, p, prev.as_deref()) };
         let result = match solved {
             Ok(sol) => {
                 its = sol.newton_total;
@@ -117,7 +114,7 @@ pub fn run<'a>(ctx: &'a Context, scene: &Scene, setup: &Setup, solver: &EhlSolve
     if failed.is_empty() {
         Ok(())
     } else {
-        Err(Error::NotConverged(format!("{} of {} sweep points failed: {} (reasons in sweep.csv)", failed.len(), n, failed.join(", "))))
+        Err(Error::not_converged(format!("{} of {} sweep points failed: {} (reasons in sweep.csv)", failed.len(), n, failed.join(", "))))
     }
 }
 

@@ -55,8 +55,9 @@ pub enum Error {
     #[error("{0}")]
     Format(String),
     /// Newton (or a series of solves: a sweep, a convergence study) did not converge.
-    #[error("{0}")]
-    NotConverged(String),
+    /// `reached` is the furthest a continuation got on the way, if any got past its start.
+    #[error("{message}")]
+    NotConverged { message: String, reached: Option<Box<Reached>> },
     /// Newton did not converge, and on the way its iterates closed the film (H <= 0) at
     /// `closed` (X, Z in units of a, in the order met): where the mesh was too coarse for
     /// the film, or where the model has none (a spin pole; the message says which).
@@ -133,6 +134,20 @@ impl Error {
     /// [`Error::Invalid`].
     pub fn invalid(message: impl Into<String>) -> Self {
         Error::Invalid(message.into())
+    }
+
+    /// [`Error::NotConverged`], with no continuation state.
+    pub fn not_converged(message: impl Into<String>) -> Self {
+        Error::NotConverged { message: message.into(), reached: None }
+    }
+
+    /// The furthest state of a continuation that did not reach the scene, if the failure
+    /// carries one.
+    pub fn reached(&self) -> Option<&Reached> {
+        match self.root() {
+            Error::NotConverged { reached, .. } | Error::FilmClosed { reached, .. } => reached.as_deref(),
+            _ => None,
+        }
     }
 
     /// [`Error::Format`].

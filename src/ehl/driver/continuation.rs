@@ -289,7 +289,7 @@ impl Newton<'_> {
                 // problem has a smaller factorisation, so the continuation would only repeat it.
                 let why = self.snes.linear_failure()?;
                 if why.mumps_infog.is_some_and(|(i, _)| petsc::factor::mumps_memory_code(i)) {
-                    return Err(Error::NotConverged(format!("the linear solver cannot factorise the Jacobian: {why}")));
+                    return Err(Error::not_converged(format!("the linear solver cannot factorise the Jacobian: {why}")));
                 }
             }
         }
@@ -405,12 +405,9 @@ impl Newton<'_> {
         Ok(None)
     }
 
-    /// Ramps `h` from t (where `state` is converged) to the scene's problem at t = 1,
-    /// multiplying t by the ramp's ratio, by its square root after each failure, and giving
-    /// up below a ratio of 1.05; a value of `schedule` (where a coarser level's ramp
-    /// converged) between t and that is taken instead. Returns whether t = 1 converged,
-    /// the last report, the last converged state, and the values of t < 1 converged at
-    /// (from the first t on).
+    /// Ramps `h` from t (where `state` is converged) to the scene's problem at t = 1 by the
+    /// steps of [`RampSteps`]. Returns whether t = 1 converged, the last report, the last
+    /// converged state, and the values of t < 1 converged at (from the first t on).
     #[allow(clippy::type_complexity)]
     fn ramp(
         &mut self,
@@ -419,41 +416,69 @@ impl Newton<'_> {
         mut t: f64,
         mut state: Vec<f64>,
         system: &mut dyn EhlProblem,
-        mut schedule: &[f64],
+        schedule: &[f64],
     ) -> Result<(bool, Option<SolveReport>, Vec<f64>, Vec<f64>), Error> {
-        let mut ratio = h.ramp.ratio;
+        let mut steps = RampSteps { ratio: h.ramp.ratio, schedule };
         let mut last = None;
         let mut below = vec![t];
         while t < 1.0 {
-            // Within round-off of the end is the end (heavy-3gpa's load ramp by factors of
-            // 2^(1/4) ended at t = 1 - 1e-16, then solved t = 1 again in 0 iterations).
-            let next = if t * ratio > 1.0 - 1e-9 { 1.0 } else { t * ratio };
-            let planned = schedule.iter().copied().find(|&s| s > t * (1.0 + 1e-9)).filter(|&s| s < next);
-            let next = planned.unwrap_or(next);
+            let (next, planned) = steps.next(t);
             let (r, xs) = self.solve_at(from, h.parameter, next, system, &state, "")?;
-            match xs {
-                Some(xs) => {
-                    if next < 1.0 {
-                        below.push(next);
-                    }
-                    state = xs;
-                    t = next;
+            let converged = xs.is_some();
+            if let Some(xs) = xs {
+                if next < 1.0 {
+                    below.push(next);
                 }
-                None => {
-                    // A failed scheduled step is halved (in log t) from the step tried, and
-                    // the ramp goes on by its own ratio from there; such a step may be below
-                    // the smallest ratio once (the coarser level's path had small steps).
-                    ratio = planned.map_or(ratio, |s| s / t).sqrt();
-                    if planned.is_some() {
-                        schedule = &[];
-                    } else if ratio < 1.05 {
-                        return Ok((false, Some(r), state, below));
-                    }
-                }
+                state = xs;
+                t = next;
             }
             last = Some(r);
+            if !converged && !steps.failed(t, next, planned) {
+                return Ok((false, last, state, below));
+            }
         }
         Ok((true, last, state, below))
+    }
+}
+
+/// The steps of a continuation's ramp towards t = 1: t times the ratio (the last step cut
+/// at t = 1), or a value of the schedule (where a coarser level's ramp converged) between
+/// t and that.
+struct RampSteps<'s> {
+    ratio: f64,
+    schedule: &'s [f64],
+}
+
+impl RampSteps<'_> {
+    /// A ramp gives up when a failed step would be followed by a ratio below this.
+    const SMALLEST_RATIO: f64 = 1.05;
+
+    /// The value to try from t, and whether it is a value of the schedule.
+    fn next(&self, t: f64) -> (f64, bool) {
+        // Within round-off of the end is the end (heavy-3gpa's load ramp by factors of
+        // 2^(1/4) ended at t = 1 - 1e-16, then solved t = 1 again in 0 iterations).
+        let next = if t * self.ratio > 1.0 - 1e-9 { 1.0 } else { t * self.ratio };
+        match self.schedule.iter().copied().find(|&s| s > t * (1.0 + 1e-9)).filter(|&s| s < next) {
+            Some(s) => (s, true),
+            None => (next, false),
+        }
+    }
+
+    /// After the step from t to `tried` failed: the ratio becomes the square root of the
+    /// step tried (a step cut at t = 1 is halved in log t from its own size, so the same
+    /// failing solve is not repeated: from a scheduled alpha/1.41 with the ratio still 2,
+    /// the step to alpha failed, and the square root of 2 gave alpha again). A failed
+    /// scheduled step drops the schedule, and the ramp goes on by its own ratio from there;
+    /// such a step may be below the smallest ratio once (the coarser level's path had small
+    /// steps). Returns false when the ramp gives up.
+    fn failed(&mut self, t: f64, tried: f64, planned: bool) -> bool {
+        self.ratio = (tried / t).sqrt();
+        if planned {
+            self.schedule = &[];
+            true
+        } else {
+            self.ratio >= Self::SMALLEST_RATIO
+        }
     }
 }
 
@@ -612,7 +637,7 @@ pub(super) fn newton_with_continuation(
             nw.steps.join("; ")
         );
         return Err(match nw.closed.is_empty() {
-            true => Error::NotConverged(message),
+            true => Error::NotConverged { message, reached: furthest.map(Box::new) },
             false => Error::FilmClosed { message, closed: nw.closed, reached: furthest.map(Box::new) },
         });
     };
@@ -629,7 +654,43 @@ fn new_snes(comm: petsc::ffi::MPI_Comm) -> Result<Snes, Error> {
 
 #[cfg(test)]
 mod tests {
-    use super::{homotopies, Parameter};
+    use super::{homotopies, Parameter, RampSteps};
+
+    /// The values a ramp from t0 tries when a step from t to t' converges iff `ok(t, t')`.
+    fn tried(t0: f64, ratio: f64, schedule: &[f64], ok: impl Fn(f64, f64) -> bool) -> (bool, Vec<f64>) {
+        let (mut steps, mut t, mut out) = (RampSteps { ratio, schedule }, t0, Vec::new());
+        while t < 1.0 {
+            let (next, planned) = steps.next(t);
+            out.push(next);
+            if ok(t, next) {
+                t = next;
+            } else if !steps.failed(t, next, planned) {
+                return (false, out);
+            }
+        }
+        (true, out)
+    }
+
+    #[test]
+    fn a_ramp_halves_a_failed_step_and_never_repeats_it() {
+        let close = |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+        let (r2, r4) = (2f64.sqrt(), 2f64.powf(0.25));
+        // By factors of 2 from 1/2, converging only by steps up to 1.3: 1 fails, 1/sqrt(2)
+        // fails, then steps of 2^(1/4) reach 1.
+        let (done, t) = tried(0.5, 2.0, &[], |t, n| n / t <= 1.3);
+        assert!(done && close(&t, &[1.0, 0.5 * r2, 0.5 * r4, 0.5 * r2, 0.5 * r2 * r4, 1.0]), "{t:?}");
+        // A problem that converges only up to t = 0.9, from the scheduled 1/sqrt(2) with the
+        // ratio still 2: the step to 1 is cut to sqrt(2) and fails; the next try is
+        // 2^(1/4) from there, not 1 again.
+        let (done, t) = tried(0.5, 2.0, &[0.5f64.sqrt()], |_, n| n <= 0.9);
+        assert!(!done && close(&t, &[0.5 * r2, 1.0, 0.5 * r2 * r4, 1.0, 0.5 * r2 * r4 * 2f64.powf(0.125)]), "{t:?}");
+        assert!(t.windows(2).all(|w| w[0] != w[1]), "a failed step was tried again: {t:?}");
+        // A step cut at t = 1 whose square root is below the smallest ratio: no retry.
+        assert_eq!(tried(0.96, 2.0, &[], |_, _| false), (false, vec![1.0]));
+        // Steps of 2, 2^(1/2), 2^(1/4), 2^(1/8) and then the ramp gives up.
+        let (done, t) = tried(0.5, 2.0, &[], |_, _| false);
+        assert!(!done && t.len() == 4, "{t:?}");
+    }
 
     #[test]
     fn the_homotopies_reach_the_scene_at_t_equal_1_and_are_milder_below() {

@@ -322,7 +322,7 @@ fn solve_condensed(
     };
     // A failure's furthest state is reported in the monolithic layout too.
     let out = out.map_err(|mut e| {
-        if let Error::FilmClosed { reached: Some(r), .. } = &mut e {
+        if let Error::FilmClosed { reached: Some(r), .. } | Error::NotConverged { reached: Some(r), .. } = &mut e {
             r.x = monolithic(&r.x);
         }
         e

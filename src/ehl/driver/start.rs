@@ -232,7 +232,7 @@ pub(super) fn rigid_start(
                 continue;
             }
             result =
-                Err(Error::NotConverged(format!("rigid start: the pressure of the film H0 = {h0:.4e} did not converge ({})", r.reason)));
+                Err(Error::not_converged(format!("rigid start: the pressure of the film H0 = {h0:.4e} did not converge ({})", r.reason)));
             break;
         }
         let xs = x.gather_all()?;
