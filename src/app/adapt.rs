@@ -26,7 +26,7 @@
 //!    last level's result is written with its estimated error, `accuracy.reached` is
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
 use super::estimate::Estimate;
-use super::first_level::{closures, first_level_again, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
+use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, Setup};
 use super::marking::{cut_count, goal_mark, goals, longest_edges, next_field, zone_mark, Marking, MIN_BUDGET_SHARE};
 use super::{Context, Outcome};
@@ -223,28 +223,14 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 // failed at 64.7 -> 68.3, where the one from the coarser level's alpha/2
                 // converges (docs/accuracy.md).
                 let onward_state = raised_from.take();
-                let of = onward_state.as_ref().map(|r| FieldsOnFace::new(&setup.mesh, &setup.layout, &r.x));
-                let po = |x: f64, z: f64| of.as_ref().and_then(|f| f.at(x, z)).map_or(0.0, |v| v.0);
-                let onward_label = format!("level {k}'s state where its try before the raise stopped");
-                let onward_ts = onward_state.as_ref().map_or(vec![], |r| vec![r.t]);
-                let start = match (&onward_state, &of) {
-                    (Some(r), Some(f)) => {
-                        let hc = f.stats().hc;
-                        let milder = Milder { parameter: r.parameter, ts: &onward_ts, p: &po, hc, label: &onward_label };
-                        let here = Coarser { mesh: &setup.mesh, layout: &setup.layout, x: &r.x };
-                        Start::Pressure {
-                            p: &po,
-                            hc,
-                            label: &onward_label,
-                            plain: false,
-                            milder: Some(milder),
-                            last_resorts: false,
-                            coarser: Some(here),
-                        }
+                let solved = match &onward_state {
+                    Some(r) => {
+                        let label = format!("level {k}'s state where its try before the raise stopped");
+                        from_reached(ctx, scene, &solver, &setup, r, &label, true)
                     }
-                    _ => start,
+                    None => solver.solve_from(ctx, scene, start),
                 };
-                let solved = collective::agree(&ctx.world, solver.solve_from(ctx, scene, start));
+                let solved = collective::agree(&ctx.world, solved);
                 match solved {
                     Ok(sol) => sol,
                     // A level that does not converge with a small gradient-jump factor is

@@ -7,7 +7,7 @@ use super::marking::{field_of_sizes, longest_edges, next_field, within_bands, wi
 use super::Context;
 use crate::case::Scene;
 use crate::collective;
-use crate::ehl::driver::{EhlSolution, EhlSolver, Milder, Start};
+use crate::ehl::driver::{Coarser, EhlSolution, EhlSolver, Milder, Start};
 use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
 use crate::mesh::size_field::SizeField;
@@ -137,27 +137,42 @@ pub(super) enum Onward {
 ///   cases/hard/spin-0.33deg's retry (166,728 unknowns) spent 305 s in plain Newton from
 ///   the Hertz start and did not converge.
 pub(super) fn onward<'a>(ctx: &'a Context, scene: &Scene, solver: &EhlSolver<'a>, from: Option<&Onward>) -> Result<EhlSolution, Error> {
-    let (setup, x, reached) = match from {
-        None => return solver.solve(ctx, scene, None),
-        Some(Onward::Reached(setup, r)) => (setup, &r.x, Some(r)),
-        Some(Onward::Converged(setup, x)) => (setup, x, None),
-    };
-    let f = FieldsOnFace::new(&setup.mesh, &setup.layout, x);
+    let label = |setup: &Setup| format!("the failed try's state ({} contact triangles)", setup.mesh.contact_tris.len());
+    match from {
+        None => solver.solve(ctx, scene, None),
+        Some(Onward::Reached(setup, r)) => from_reached(ctx, scene, solver, setup, r, &label(setup), false),
+        Some(Onward::Converged(setup, x)) => {
+            let f = FieldsOnFace::new(&setup.mesh, &setup.layout, x);
+            let p = |x: f64, z: f64| f.at(x, z).map_or(0.0, |v| v.0);
+            let label = label(setup);
+            solver.solve_from(
+                ctx,
+                scene,
+                Start::Pressure { p: &p, hc: f.stats().hc, label: &label, plain: true, milder: None, last_resorts: true, coarser: None },
+            )
+        }
+    }
+}
+
+/// Solves from `r`, the furthest state (on `setup`'s mesh, described by `label`) of a
+/// continuation that did not reach the scene: that continuation's milder problem from the
+/// state, ramped to the scene, with no plain Newton before it and no last resorts after it
+/// (the caller has its own next try). `same_mesh`: `r` is a state of the solver's own mesh
+/// (a level solved again), whose displacement then starts a monolithic solve as it is.
+pub(super) fn from_reached<'a>(
+    ctx: &'a Context,
+    scene: &Scene,
+    solver: &EhlSolver<'a>,
+    setup: &Setup,
+    r: &Reached,
+    label: &str,
+    same_mesh: bool,
+) -> Result<EhlSolution, Error> {
+    let f = FieldsOnFace::new(&setup.mesh, &setup.layout, &r.x);
     let p = |x: f64, z: f64| f.at(x, z).map_or(0.0, |v| v.0);
     let hc = f.stats().hc;
-    let label = format!("the failed try's state ({} contact triangles)", setup.mesh.contact_tris.len());
-    let Some(r) = reached else {
-        return solver.solve_from(
-            ctx,
-            scene,
-            Start::Pressure { p: &p, hc, label: &label, plain: true, milder: None, last_resorts: true, coarser: None },
-        );
-    };
     let ts = [r.t];
-    let milder = Milder { parameter: r.parameter, ts: &ts, p: &p, hc, label: &label };
-    solver.solve_from(
-        ctx,
-        scene,
-        Start::Pressure { p: &p, hc, label: &label, plain: false, milder: Some(milder), last_resorts: false, coarser: None },
-    )
+    let milder = Milder { parameter: r.parameter, ts: &ts, p: &p, hc, label };
+    let coarser = same_mesh.then_some(Coarser { mesh: &setup.mesh, layout: &setup.layout, x: &r.x });
+    solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc, label, plain: false, milder: Some(milder), last_resorts: false, coarser })
 }
