@@ -2,14 +2,21 @@
 //! that it grows by at most `growth` per unit distance (a Lipschitz bound), for adaptive
 //! refinement: the sizes come from an error estimate on a previous mesh's contact
 //! triangles, and the mesher ([`super::generate`]) bisects every tetrahedron longer than
-//! the field under it plus `growth` times its depth.
+//! the field under it plus `growth` times its depth. A pyramid of block minima answers
+//! that question for a large tetrahedron without reading every cell under it.
 //!
 //! All lengths in units of the Hertz radius `a`.
 
 use super::spec::Rect;
 
-/// Most cells a field may have (4 M cells: 32 MB).
-const MAX_CELLS: usize = 1 << 22;
+/// Most cells a field may have (8 M cells: 64 MB and a third more for the pyramid; a half
+/// face of 6 a x 3 a at 1/512 a). Sizes finer than the cells are kept all the same: the
+/// cells under a small triangle take its size, so the field is over-refined by at most a
+/// cell around it.
+const MAX_CELLS: usize = 1 << 23;
+
+/// Most cells [`SizeField::min_over`] reads for one box.
+const MAX_READS: usize = 4096;
 
 /// A graded size field on a rectangle of the top face.
 #[derive(Clone, PartialEq)]
@@ -23,6 +30,16 @@ pub struct SizeField {
     growth: f64,
     /// Smallest size imposed.
     min_size: f64,
+    /// Minima over blocks of 2^l x 2^l cells, l = 1, 2, ... (built by [`SizeField::grade`]),
+    /// so that a large box reads a few blocks instead of every cell under it.
+    pyramid: Vec<Level>,
+}
+
+/// One level of [`SizeField`]'s pyramid: the minimum of each block of cells.
+#[derive(Clone, PartialEq)]
+struct Level {
+    nx: usize,
+    min: Vec<f64>,
 }
 
 impl std::fmt::Debug for SizeField {
@@ -50,7 +67,7 @@ impl SizeField {
         }
         let nx = ((w / step).ceil() as usize).max(1);
         let nz = ((d / step).ceil() as usize).max(1);
-        SizeField { region, step, nx, nz, size: vec![coarse; nx * nz], growth, min_size: coarse }
+        SizeField { region, step, nx, nz, size: vec![coarse; nx * nz], growth, min_size: coarse, pyramid: Vec::new() }
     }
 
     /// Smallest size of the field.
@@ -83,6 +100,15 @@ impl SizeField {
         let area2 = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
         if area2 == 0.0 {
             return;
+        }
+        // The cells under the vertices and the centroid, which a triangle smaller than a
+        // cell may leave without a centre inside it.
+        let centroid = [(t[0][0] + t[1][0] + t[2][0]) / 3.0, (t[0][1] + t[1][1] + t[2][1]) / 3.0];
+        for p in t.iter().chain(std::iter::once(&centroid)) {
+            let i = (((p[0] - self.region.x0) / self.step).floor().max(0.0) as usize).min(self.nx - 1);
+            let k = (((p[1] - self.region.z0) / self.step).floor().max(0.0) as usize).min(self.nz - 1);
+            let s = &mut self.size[k * self.nx + i];
+            *s = s.min(size);
         }
         let tol = 0.5 * self.step;
         for k in k0..k1 {
@@ -126,12 +152,32 @@ impl SizeField {
         };
         sweep(&mut (0..nz).flat_map(|k| (0..nx).map(move |i| (i, k))), 1);
         sweep(&mut (0..nz).rev().flat_map(|k| (0..nx).rev().map(move |i| (i, k))), -1);
+        self.build_pyramid();
+    }
+
+    /// Halves the grid until one block is left, each block the minimum of the (up to) four
+    /// below it.
+    fn build_pyramid(&mut self) {
+        self.pyramid.clear();
+        let (mut nx, mut nz) = (self.nx, self.nz);
+        while nx > 1 || nz > 1 {
+            let below = self.pyramid.last().map_or(&self.size, |l| &l.min);
+            let (cx, cz) = (nx.div_ceil(2), nz.div_ceil(2));
+            let mut min = vec![f64::INFINITY; cx * cz];
+            for k in 0..nz {
+                for i in 0..nx {
+                    let m = &mut min[(k / 2) * cx + i / 2];
+                    *m = m.min(below[k * nx + i]);
+                }
+            }
+            self.pyramid.push(Level { nx: cx, min });
+            (nx, nz) = (cx, cz);
+        }
     }
 
     /// The smallest size over the cells meeting the box `[lo, hi]` (X, Z), plus `growth`
     /// times the distance from the box to the field's rectangle when it lies (partly)
-    /// outside. A box of many cells gets a lower bound (the centre cell's size less
-    /// `growth` times the half diagonal), which refines at most a little more than needed.
+    /// outside. A box of more than [`MAX_READS`] cells gets a lower bound from the pyramid.
     pub fn min_over(&self, lo: [f64; 2], hi: [f64; 2]) -> f64 {
         let r = &self.region;
         let gap_x = (r.x0 - hi[0]).max(lo[0] - r.x1).max(0.0);
@@ -143,20 +189,25 @@ impl SizeField {
         let (k0, k1) = self.cell_range(cl[1], ch[1], r.z0, self.nz);
         let (i1, k1) = (i1.max(i0 + 1).min(self.nx), k1.max(k0 + 1).min(self.nz));
         let (i0, k0) = (i0.min(self.nx - 1), k0.min(self.nz - 1));
-        let cells = (i1 - i0) * (k1 - k0);
-        let m = if cells <= 4096 {
-            let mut m = f64::INFINITY;
-            for k in k0..k1 {
-                for i in i0..i1 {
-                    m = m.min(self.size[k * self.nx + i]);
-                }
+        // Up to 64 x 64 cells, every cell; beyond, the first level of the pyramid on which
+        // the box spans at most 64 blocks each way. Its blocks cover the box and at most one
+        // block more on each side, so their minimum is a lower bound of the box's, below it
+        // by at most growth times a block's diagonal (the field is graded): a tetrahedron is
+        // refined at most a little more than needed.
+        let mut level = 0;
+        if (i1 - i0) * (k1 - k0) > MAX_READS {
+            let span = |a: usize, b: usize, l: usize| ((b - 1) >> l) - (a >> l) + 1;
+            while level < self.pyramid.len() && (span(i0, i1, level) > 64 || span(k0, k1, level) > 64) {
+                level += 1;
             }
-            m
-        } else {
-            let (ic, kc) = ((i0 + i1) / 2, (k0 + k1) / 2);
-            let half_diag = 0.5 * self.step * (((i1 - i0) as f64).hypot((k1 - k0) as f64));
-            (self.size[kc * self.nx + ic] - self.growth * half_diag).max(self.min_size)
-        };
+        }
+        let (cells, nx) = if level == 0 { (&self.size, self.nx) } else { (&self.pyramid[level - 1].min, self.pyramid[level - 1].nx) };
+        let mut m = f64::INFINITY;
+        for k in (k0 >> level)..=((k1 - 1) >> level) {
+            for i in (i0 >> level)..=((i1 - 1) >> level) {
+                m = m.min(cells[k * nx + i]);
+            }
+        }
         m + outside
     }
 
@@ -192,6 +243,43 @@ mod tests {
                 assert!((a - b).abs() <= 0.5 * f.step * 1.0000001 && (a - c).abs() <= 0.5 * f.step * 1.0000001);
             }
         }
+    }
+
+    #[test]
+    fn a_large_box_gets_a_lower_bound_within_a_block_of_its_minimum() {
+        let mut f = SizeField::new(square(), 0.002, 1.0, 0.5);
+        f.impose_triangle(&[[0.3, 0.3], [0.31, 0.3], [0.3, 0.31]], 0.004);
+        f.impose_triangle(&[[-0.5, -0.2], [-0.45, -0.2], [-0.5, -0.1]], 0.01);
+        f.grade();
+        let exact = |lo: [f64; 2], hi: [f64; 2]| {
+            let (i0, i1) = f.cell_range(lo[0], hi[0], f.region.x0, f.nx);
+            let (k0, k1) = f.cell_range(lo[1], hi[1], f.region.z0, f.nz);
+            let mut m = f64::INFINITY;
+            for k in k0..k1.max(k0 + 1) {
+                for i in i0..i1.max(i0 + 1) {
+                    m = m.min(f.size[k * f.nx + i]);
+                }
+            }
+            m
+        };
+        for (lo, hi) in [([-0.9, -0.9], [0.9, 0.9]), ([0.2, -0.4], [0.45, 0.1]), ([-0.7, -0.6], [-0.52, 0.3]), ([0.0, 0.0], [0.05, 0.9])] {
+            let (bound, m) = (f.min_over(lo, hi), exact(lo, hi));
+            // Blocks of at most 1/32 of the box's width (it spans 33-64 of them), one more
+            // on each side: the bound is within growth times a block's diagonal.
+            let slack = (hi[0] - lo[0]).max(hi[1] - lo[1]) / 32.0 * std::f64::consts::SQRT_2;
+            assert!(bound <= m && bound >= m - slack, "box {lo:?}..{hi:?}: bound {bound}, minimum {m}");
+        }
+    }
+
+    #[test]
+    fn a_triangle_smaller_than_a_cell_still_sets_its_cell() {
+        // Cells of 0.05 a; a triangle of 0.004 a near a cell corner, whose enlarged outline
+        // holds no cell centre.
+        let mut f = SizeField::new(square(), 0.05, 1.0, 0.5);
+        f.impose_triangle(&[[0.001, 0.001], [0.005, 0.001], [0.001, 0.005]], 0.004);
+        f.grade();
+        assert_eq!(f.at(0.003, 0.002), 0.004);
+        assert_eq!(f.min_over([0.0, 0.0], [0.01, 0.01]), 0.004);
     }
 
     #[test]
