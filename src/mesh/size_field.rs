@@ -28,8 +28,6 @@ pub struct SizeField {
     /// Size at each cell (row-major in x), after [`SizeField::grade`].
     size: Vec<f64>,
     growth: f64,
-    /// Smallest size imposed.
-    min_size: f64,
     /// Minima over blocks of 2^l x 2^l cells, l = 1, 2, ... (built by [`SizeField::grade`]),
     /// so that a large box reads a few blocks instead of every cell under it.
     pyramid: Vec<Level>,
@@ -50,7 +48,7 @@ impl std::fmt::Debug for SizeField {
             self.nx,
             self.nz,
             self.step,
-            self.min_size,
+            self.size.iter().cloned().fold(f64::INFINITY, f64::min),
             self.size.iter().cloned().fold(0.0, f64::max)
         )
     }
@@ -67,12 +65,7 @@ impl SizeField {
         }
         let nx = ((w / step).ceil() as usize).max(1);
         let nz = ((d / step).ceil() as usize).max(1);
-        SizeField { region, step, nx, nz, size: vec![coarse; nx * nz], growth, min_size: coarse, pyramid: Vec::new() }
-    }
-
-    /// Smallest size of the field.
-    pub fn min_size(&self) -> f64 {
-        self.min_size
+        SizeField { region, step, nx, nz, size: vec![coarse; nx * nz], growth, pyramid: Vec::new() }
     }
 
     /// Cell spacing.
@@ -127,7 +120,6 @@ impl SizeField {
                 }
             }
         }
-        self.min_size = self.min_size.min(size);
     }
 
     /// Grades the field: size(x) <= size(y) + growth |x - y| for all cells (two chamfer
