@@ -256,8 +256,17 @@ pub fn post_point(
         Some(fs) => {
             let f = friction_pass(&fields, fs)?;
             ctx.log(format!(
-                "friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s)",
-                scene.effects.friction, f.fx, f.fz, f.fx_n, f.fz_n, f.tau_max, f.seconds
+                "friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s; the rule subdivided on {} of {} triangles, {} stress evaluations)",
+                scene.effects.friction,
+                f.fx,
+                f.fz,
+                f.fx_n,
+                f.fz_n,
+                f.tau_max,
+                f.seconds,
+                f.quadrature.subdivided,
+                f.quadrature.triangles,
+                f.quadrature.evaluations
             ));
             // A lubricated contact's friction coefficient is of order 0.01-0.1; above 1 the
             // Newtonian law has carried exp(alpha p) viscosities into shear stresses no
@@ -425,6 +434,13 @@ pub fn post_point(
             fx_n: f.fx_n,
             fz_n: f.fz_n,
             tau_max_pa: f.tau_max,
+            quadrature: Some(FrictionQuadratureSummary {
+                triangles: f.quadrature.triangles,
+                subdivided: f.quadrature.subdivided,
+                stress_evaluations: f.quadrature.evaluations,
+                fixed_rule_fx: f.fixed_rule[0],
+                fixed_rule_fz: f.fixed_rule[1],
+            }),
         }),
     };
     let mut summary = to_json(&summary)?;

@@ -201,6 +201,20 @@ pub struct FrictionSummary {
     pub fz_n: f64,
     #[serde(deserialize_with = "nan_if_null")]
     pub tau_max_pa: f64,
+    /// The pass's adapted quadrature (absent in summaries written before it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quadrature: Option<FrictionQuadratureSummary>,
+}
+
+/// The friction pass's quadrature: how far it adapted, and what the fixed 12-point rule on
+/// every triangle gives instead.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct FrictionQuadratureSummary {
+    pub triangles: usize,
+    pub subdivided: usize,
+    pub stress_evaluations: usize,
+    pub fixed_rule_fx: f64,
+    pub fixed_rule_fz: f64,
 }
 
 /// The summary of a dry Hertz run.
