@@ -333,12 +333,12 @@ impl Adapting<'_> {
     }
 }
 
-/// The adapted rule of every contact triangle of Omega_c. The tolerance of a triangle is its share by area of
-/// QUADRATURE_TOL times the force's magnitude by the fixed rule, so that the errors add up
-/// to about QUADRATURE_TOL of it (a triangle's error is estimated by the difference
-/// between its rule and its quarters', a sub-triangle's error in turn by its own quarters).
-/// The same rule serves the pass and its gradient, which therefore is the derivative of
-/// the value the pass reports.
+/// The adapted rule of every contact triangle of Omega_c. The tolerance of a triangle is
+/// its share by area of QUADRATURE_TOL times the force's magnitude by the fixed rule, so
+/// that the errors add up to about QUADRATURE_TOL of it (a triangle's error is estimated
+/// by the difference between its rule and its quarters', a sub-triangle's error in turn by
+/// its own quarters). The same rule serves the pass and its gradient, which therefore is
+/// the derivative of the value the pass reports.
 fn adapted_rules(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<AdaptedRules, Error> {
     let mesh = fields.mesh();
     let mut report = QuadratureReport::default();
