@@ -28,7 +28,7 @@
 use super::estimate::Estimate;
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, Setup};
-use super::marking::{cut_count, goal_mark, goals, longest_edges, next_field, zone_mark, Marking, MIN_BUDGET_SHARE};
+use super::marking::{cut_count, goal_mark, goals, longest_edges, next_field, zone_mark, Marking, TimeLeft, MIN_BUDGET_SHARE};
 use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
 use crate::case::Scene;
@@ -76,6 +76,8 @@ pub struct Level {
     /// The share of its marked triangles' indicator the level refined when all of them would
     /// have exceeded `accuracy.max_unknowns` (None: all of them).
     pub budget_share: Option<f64>,
+    /// The budget that cut it: "accuracy.max_unknowns" or "accuracy.max_seconds".
+    pub cut_by: Option<&'static str>,
 }
 
 /// A solved level kept for the next one: its setup, solution, dimensionless central film
@@ -129,7 +131,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     // How many of its marked triangles the present level refines when all of them would
     // exceed the budget, with the share of the indicator they carry, and the meshes tried
     // for it that were over the budget (count, unknowns).
-    let mut cut: Option<(usize, f64)> = None;
+    let mut cut: Option<(usize, f64, &'static str)> = None;
     let mut over: Vec<(usize, u64)> = Vec::new();
     loop {
         let scene = &own;
@@ -141,33 +143,48 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
         };
         let (n_u, n_p) = setup.layout.counts();
-        if let (Some(prev), true) = (&previous, (n_u + n_p + 1) as u64 > acc.max_unknowns) {
+        let n = (n_u + n_p + 1) as u64;
+        // The time budget as a bound on the level's unknowns: what the level before's cost
+        // per unknown lets end in the time left. A level that would not end in it is cut
+        // or not begun, rather than abandoned at the deadline after most of its cost.
+        let time = time_left(ctx, acc, &levels, previous.as_ref());
+        let by_time = time.filter(|t| t.unknowns() < acc.max_unknowns);
+        let budget = by_time.map_or(acc.max_unknowns, |t| t.unknowns());
+        if let (Some(prev), true) = (&previous, n > budget) {
             // The level is cut to the budget: the marked triangles of largest indicator that
             // fit, once per run (a cut level is the last, below), and not when even the next
             // full level's change could not take every estimate below the target.
             let before = levels.last().map_or(0, |l| (l.elastic_unknowns + l.pressure_unknowns + 1) as u64);
+            let over_what = match by_time {
+                Some(t) => format!(
+                    "level {k} would have {n} unknowns and take about {:.0} s at level {}'s cost ({} unknowns in {:.0} s), more than the {:.0} s left of accuracy.max_seconds = {} s",
+                    t.predicted(n),
+                    k - 1,
+                    t.before,
+                    t.seconds,
+                    t.left.max(0.0),
+                    acc.max_seconds
+                ),
+                None => format!("level {k} would have {n} unknowns, above accuracy.max_unknowns = {}", acc.max_unknowns),
+            };
             let ranked = prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| over.len() < MAX_CUTS);
             let hopeful = ranked.is_some() && Estimate::cut_could_reach(&levels, target);
             if let Some((m, marked)) = ranked.filter(|_| hopeful) {
-                over.push((cut.map_or(marked, |c| c.0), (n_u + n_p + 1) as u64));
-                let count = cut_count(before, &over, acc.max_unknowns);
+                over.push((cut.map_or(marked, |c| c.0), n));
+                let count = cut_count(before, &over, budget);
                 let share = m.indicator_share(count);
                 if share >= MIN_BUDGET_SHARE {
                     ctx.log(format!(
-                        "accuracy: level {k} would have {} unknowns, above accuracy.max_unknowns = {}; it refines the {count} of the {marked} marked triangles with the largest indicator instead ({:.0} % of their indicator)",
-                        n_u + n_p + 1,
-                        acc.max_unknowns,
+                        "accuracy: {over_what}; it refines the {count} of the {marked} marked triangles with the largest indicator instead ({:.0} % of their indicator)",
                         100.0 * share
                     ));
                     field = Some(Arc::new(next_field(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), &m.largest(count), growth)));
-                    cut = Some((count, share));
+                    cut = Some((count, share, if by_time.is_some() { "accuracy.max_seconds" } else { "accuracy.max_unknowns" }));
                     continue;
                 }
             }
             let why = format!(
-                "level {k} would have {} unknowns, above accuracy.max_unknowns = {}{}",
-                n_u + n_p + 1,
-                acc.max_unknowns,
+                "{over_what}{}",
                 if ranked.is_some() && !hopeful { " (a level cut to it could not take every estimate below the target)" } else { "" }
             );
             let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
@@ -380,7 +397,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             pmax: st.pmax * ph,
             friction: level_friction(scene, &fields)?,
             est: None,
-            budget_share: cut.take().map(|c| c.1),
+            budget_share: cut.map(|c| c.1),
+            cut_by: cut.take().map(|c| c.2),
         };
         over.clear();
         levels.push(level);
@@ -395,7 +413,11 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             "accuracy: level {k}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}; estimated error {}",
             level.contact_triangles,
             level.min_size,
-            level.budget_share.map_or(String::new(), |s| format!(" (cut to the budget: {:.0} % of the marked indicator)", 100.0 * s)),
+            level.budget_share.map_or(String::new(), |s| format!(
+                " (cut to the budget {}: {:.0} % of the marked indicator)",
+                level.cut_by.unwrap_or("accuracy.max_unknowns"),
+                100.0 * s
+            )),
             n_u + n_p + 1,
             level.newton_iterations,
             level.seconds,
@@ -468,7 +490,15 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
         if cut_level {
-            let why = format!("level {k} was cut to accuracy.max_unknowns = {}: the level after it would exceed it", acc.max_unknowns);
+            let why = match levels.last().and_then(|l| l.cut_by) {
+                Some("accuracy.max_seconds") => {
+                    format!(
+                        "level {k} was cut to the time left of accuracy.max_seconds = {} s: the level after it would not end in it",
+                        acc.max_seconds
+                    )
+                }
+                _ => format!("level {k} was cut to accuracy.max_unknowns = {}: the level after it would exceed it", acc.max_unknowns),
+            };
             return finish(ctx, scene, &here, target, &levels, Some(short_of(target, &why, k, est)));
         }
         let marked = &here.marking.as_ref().expect("marked when the loop goes on").marked;
@@ -499,6 +529,22 @@ fn newton_failed(ctx: &Context, e: &Error) -> bool {
 fn reason(e: &Error) -> String {
     let why = e.to_string();
     why.split("; path:").next().unwrap_or(&why).to_string()
+}
+
+/// The time budget as it bears on the next level (with `max_seconds` set): the seconds left
+/// and the cost of the last level, when that level is a guide: solved from a coarser level
+/// (level 0 starts from the Hertz pressure) and monolithic, as every level after it is (a
+/// level condensed onto the face has another cost per unknown: on the M = 10 point the
+/// condensed level 2 took 4.2 s for 48,396 unknowns and the monolithic level 3 33 s for
+/// 122,746).
+fn time_left(ctx: &Context, acc: crate::case::schema::Accuracy, levels: &[Level], previous: Option<&Solved>) -> Option<TimeLeft> {
+    let monolithic = previous.is_some_and(|p| p.condensation_s.is_none());
+    let last = levels.last().filter(|_| levels.len() >= 2 && monolithic && acc.max_seconds > 0.0)?;
+    Some(TimeLeft {
+        left: acc.max_seconds - ctx.start.elapsed().as_secs_f64(),
+        before: (last.elastic_unknowns + last.pressure_unknowns + 1) as u64,
+        seconds: last.seconds - last.failed_seconds,
+    })
 }
 
 /// After level `k` stopped with `e`: when the time budget was spent (and a level converged
@@ -591,6 +637,9 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
             }
             if let Some(share) = l.budget_share {
                 v["budget_share"] = json!(share);
+            }
+            if let Some(by) = l.cut_by {
+                v["cut_by"] = json!(by);
             }
             v
         }).collect::<Vec<_>>(),

@@ -195,6 +195,7 @@ mod tests {
             friction,
             est: None,
             budget_share: None,
+            cut_by: None,
         }
     }
 
