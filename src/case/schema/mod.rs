@@ -233,7 +233,7 @@ pub struct Accuracy {
     /// Wall-time budget of the refinement levels after the first, in seconds from the start
     /// of the run: a level still running when it is spent is abandoned and the last
     /// converged level's result is written with its estimated error (exit 4); 0: no
-    /// budget; default 1800.
+    /// budget; default 3600.
     pub max_seconds: f64,
 }
 
@@ -247,10 +247,13 @@ pub const DEFAULT_MARKING: f64 = 0.9;
 /// peak of a level grows like its unknowns to the power 1.2-1.4).
 pub const DEFAULT_MAX_UNKNOWNS: u64 = 600_000;
 
-/// Default of `accuracy.max_seconds`: four times the slowest Moes point that reaches 0.01 on
-/// 2 ranks (M = 200, L = 10: 472 s); the points that do not (M = 1000, L = 10) spend hours on
-/// levels whose Newton needs the continuation.
-pub const DEFAULT_MAX_SECONDS: f64 = 1800.0;
+/// Default of `accuracy.max_seconds`: one hour, about 2.5 times the slowest Moes point that
+/// reaches 0.01 on 2 ranks when the machine is idle (M = 1000, L = 20: 1,361 s) and three
+/// times M = 1000, L = 10 (1,068 s), which spent half an hour next to two other jobs and
+/// ended at the former budget of 1800 s. It still ends, with a labelled result, the runs
+/// whose fine levels Newton cannot take (hours of continuation otherwise), and a level the
+/// time left cannot hold is not begun (docs/accuracy.md).
+pub const DEFAULT_MAX_SECONDS: f64 = 3600.0;
 
 /// Element size growth of a mesh refined adaptively by default (no `[mesh]` table): the
 /// solid under the refined face coarsens by one element size per unit depth.
@@ -348,8 +351,8 @@ pub const ACCURACY_FIELDS: &[Field] = &[
         "wall-time budget of the refinement levels after the first, from the start of the run; 0: none",
         "s",
         Kind::Number(Range::Closed(0.0, 1e7)),
-        Presence::Default("1800"),
-        note = "a level still running when the budget is spent is abandoned on every rank at its next check: the last converged level's result is written with its estimated error, summary.json says accuracy.reached = false, and the exit code is 4; the first level always runs to its end"
+        Presence::Default("3600"),
+        note = "a level predicted from a monolithic level before it not to end in the time left is cut to the unknowns that fit, or not begun; a level still running when the budget is spent is abandoned on every rank at its next check: the last converged level's result is written with its estimated error, summary.json says accuracy.reached = false, and the exit code is 4; the first level always runs to its end"
     ),
 ];
 
