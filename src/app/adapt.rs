@@ -540,11 +540,10 @@ fn reason(e: &Error) -> String {
 fn time_left(ctx: &Context, acc: crate::case::schema::Accuracy, levels: &[Level], previous: Option<&Solved>) -> Option<TimeLeft> {
     let monolithic = previous.is_some_and(|p| p.condensation_s.is_none());
     let last = levels.last().filter(|_| levels.len() >= 2 && monolithic && acc.max_seconds > 0.0)?;
-    Some(TimeLeft {
-        left: acc.max_seconds - ctx.start.elapsed().as_secs_f64(),
-        before: (last.elastic_unknowns + last.pressure_unknowns + 1) as u64,
-        seconds: last.seconds - last.failed_seconds,
-    })
+    // Each rank has its own clock: rank 0's times decide for all, or the ranks could part
+    // ways over a level that fits on one and not on another.
+    let t = collective::from_rank0(&ctx.world, &[ctx.start.elapsed().as_secs_f64(), last.seconds - last.failed_seconds]);
+    Some(TimeLeft { left: acc.max_seconds - t[0], before: (last.elastic_unknowns + last.pressure_unknowns + 1) as u64, seconds: t[1] })
 }
 
 /// After level `k` stopped with `e`: when the time budget was spent (and a level converged
