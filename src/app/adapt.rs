@@ -36,6 +36,7 @@ use crate::collective;
 use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, Start};
 use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
+use crate::friction::pass::FrictionResult;
 use crate::mesh::size_field::SizeField;
 use serde_json::json;
 use std::sync::Arc;
@@ -383,6 +384,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
         let edges = longest_edges(&setup.mesh);
         let min_size = edges.iter().cloned().fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
+        // The pass's adapted rule is kept for the friction goals' gradient below.
+        let friction = level_friction(scene, &fields)?;
         let level = Level {
             elastic_unknowns: n_u,
             pressure_unknowns: n_p,
@@ -395,7 +398,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             hm: st.hm * hs,
             hm_at: st.hm_at,
             pmax: st.pmax * ph,
-            friction: level_friction(scene, &fields)?,
+            friction: friction.as_ref().map(|f| [f.fx, f.fz]),
             est: None,
             budget_share: cut.map(|c| c.1),
             cut_by: cut.take().map(|c| c.2),
@@ -450,7 +453,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 // A failed adjoint costs this level's goal-oriented marking, not the run (an
                 // interruption is acted on at the check after the marking).
                 Some(Ok(a)) => {
-                    match collective::agree(&ctx.world, goals(ctx, scene, a, &fields, &st, levels.last().and_then(|l| l.friction)))
+                    match collective::agree(&ctx.world, goals(ctx, scene, a, &fields, &st, friction.as_ref()))
                         .map(|goals| goal_mark(ctx, scene, &fields, &goals, &edges, acc.marking))
                     {
                         Ok(m) => {
@@ -576,12 +579,11 @@ fn describe(est: Option<Estimate>) -> String {
     est.map_or("none: a single level".to_string(), |e| e.describe())
 }
 
-/// The friction coefficients fx, fz of a level (every rank holds the whole iterate), or
-/// None without friction.
-fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<[f64; 2]>, Error> {
+/// The friction pass of a level (every rank holds the whole iterate), or None without
+/// friction.
+fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<FrictionResult>, Error> {
     let Some(fs) = super::lubricated::friction_setup(scene, fields.mesh.spec.contact) else { return Ok(None) };
-    let f = crate::friction::pass::friction_pass(fields, &fs)?;
-    Ok(Some([f.fx, f.fz]))
+    crate::friction::pass::friction_pass(fields, &fs).map(Some)
 }
 
 /// Writes the result of `done` (the last level solved) with the accuracy report; with a

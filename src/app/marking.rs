@@ -12,6 +12,7 @@ use crate::ehl::driver::{self, Adjoint};
 use crate::ehl::post::{FieldsOnFace, FilmStats};
 use crate::ehl::system::jump_terms_of;
 use crate::error::Error;
+use crate::friction::pass::FrictionResult;
 use crate::mesh::size_field::SizeField;
 use crate::mesh::spec::dyadic_size;
 use crate::mesh::Mesh;
@@ -186,7 +187,7 @@ pub(super) fn goals(
     adjoint: &Adjoint,
     fields: &FieldsOnFace,
     st: &FilmStats,
-    friction: Option<[f64; 2]>,
+    friction: Option<&FrictionResult>,
 ) -> Result<Vec<Goal>, Error> {
     let film = |at: [f64; 2]| -> Result<Vec<f64>, Error> { Ok(adjoint.pressure_part(&adjoint.film(ctx, &film_weights(fields, at)?)?)) };
     let mut goals = vec![Goal { name: "hc", z: film([0.0, 0.0])?, scale: st.hc }];
@@ -198,8 +199,8 @@ pub(super) fn goals(
     }
     if let Some(f) = friction {
         let setup = super::lubricated::friction_setup(scene, fields.mesh.spec.contact).expect("a scene with friction");
-        let grad = crate::friction::pass::friction_gradient(fields, &setup)?;
-        let magnitude = f[0].hypot(f[1]);
+        let grad = crate::friction::pass::friction_gradient(fields, &setup, &f.rules)?;
+        let magnitude = f.fx.hypot(f.fz);
         // On a half domain fz vanishes by symmetry, and so does its gradient.
         for (name, c) in [("fx", 0), ("fz", 1)].into_iter().take(if fields.half() { 1 } else { 2 }) {
             let dh: Vec<(u32, f64)> = grad.nodes.iter().map(|(n, g)| (*n, g[2 * c + 1])).collect();

@@ -76,6 +76,8 @@ pub struct FrictionResult {
     pub quadrature: QuadratureReport,
     /// fx and fz by the fixed 12-point rule on every triangle, for comparison.
     pub fixed_rule: [f64; 2],
+    /// The adapted rule's points, which [`friction_gradient`] differentiates.
+    pub rules: QuadratureRules,
     /// Wall time (s).
     pub seconds: f64,
 }
@@ -192,18 +194,20 @@ pub struct FrictionGradient {
 
 /// The derivatives of [`friction_pass`]'s fx and fz with respect to the nodal P and H, by
 /// the chain rule through the P2 interpolation of P, H and grad P at each point of the
-/// pass's adapted rule, held fixed (serial, the same on every rank).
-pub fn friction_gradient(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<FrictionGradient, Error> {
+/// pass's adapted rule `rules` (the pass's on the same `fields`), held fixed (serial, the
+/// same on every rank).
+pub fn friction_gradient(fields: &dyn FaceSolution, s: &FrictionSetup, rules: &QuadratureRules) -> Result<FrictionGradient, Error> {
     use crate::fem::p2tri::{p2_tri_basis_bary, p2_tri_grads_bary};
     let mesh = fields.mesh();
     let mut acc: std::collections::BTreeMap<u32, [f64; 4]> = std::collections::BTreeMap::new();
     // A half domain doubles Fx and cancels Fz (friction_pass).
     let (cx, cz) = if fields.half() { (2.0, 0.0) } else { (1.0, 1.0) };
-    for (t, rule) in adapted_rules(fields, s)?.rules {
+    for (t, rule) in &rules.0 {
+        let (t, rule) = (*t, rule.as_slice());
         let tf = TriFields::new(fields, t);
         let area = crate::fem::p2tri::tri_area(&tf.v) * s.a * s.a;
         let nodes = mesh.contact_tris[t];
-        for q in &rule {
+        for q in rule {
             let d = tf.inputs(q.l).stress_derivatives(s)?;
             let (n, dn) = (p2_tri_basis_bary(q.l), p2_tri_grads_bary(q.l, &tf.geo.grad_bary));
             let w = q.w * area / s.load;
@@ -239,10 +243,14 @@ struct RulePoint {
     w: f64,
 }
 
-/// The adapted rule of every contact triangle of Omega_c: (triangle, its points), the forces
-/// (Fx, Fz) it gives on the solved domain (N), and what it took.
+/// The adapted rule of every contact triangle of Omega_c: (triangle, its points).
+#[derive(Clone, Debug)]
+pub struct QuadratureRules(Vec<(usize, Vec<RulePoint>)>);
+
+/// The adapted rules, the forces (Fx, Fz) they give on the solved domain (N), and what they
+/// took.
 struct AdaptedRules {
-    rules: Vec<(usize, Vec<RulePoint>)>,
+    rules: QuadratureRules,
     force: [f64; 2],
     report: QuadratureReport,
 }
@@ -373,7 +381,7 @@ fn adapted_rules(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<Adapted
         report.subdivided += usize::from(a.points.len() > 12);
         rules.push((*t, a.points));
     }
-    Ok(AdaptedRules { rules, force, report })
+    Ok(AdaptedRules { rules: QuadratureRules(rules), force, report })
 }
 
 /// Runs the pass over Omega_c (serial; call it on one rank).
@@ -383,7 +391,7 @@ pub fn friction_pass(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<Fri
     let mut tau_max = 0.0f64;
     let mut nodal = Vec::new();
     const NODES: [[f64; 3]; 6] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]];
-    for (t, _) in &rules {
+    for (t, _) in &rules.0 {
         let tf = TriFields::new(fields, *t);
         let mut vals = [[0.0; 2]; 6];
         for (k, b) in NODES.iter().enumerate() {
@@ -405,6 +413,7 @@ pub fn friction_pass(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<Fri
         tau_max,
         quadrature,
         fixed_rule: [fixed[0] / s.load, fixed[1] / s.load],
+        rules,
         seconds: t0.elapsed().as_secs_f64(),
     })
 }
@@ -512,7 +521,7 @@ mod tests {
         // Only the triangles where the stress turns or rises steeply are subdivided.
         assert!(report.subdivided > 0 && report.subdivided < report.triangles / 2, "{report:?}");
         // Every rule covers its triangle: the weights sum to 1.
-        for (_, rule) in &rules {
+        for (_, rule) in &rules.0 {
             assert!((rule.iter().map(|q| q.w).sum::<f64>() - 1.0).abs() < 1e-12);
         }
     }
@@ -547,7 +556,7 @@ mod tests {
             rect: Rect { x0: -3.0, x1: 3.0, z0: -3.0, z1: 3.0 },
             load: 100.0,
         };
-        let grad = friction_gradient(&f, &s).unwrap();
+        let grad = friction_gradient(&f, &s, &friction_pass(&f, &s).unwrap().rules).unwrap();
         let scale = grad.nodes.iter().flat_map(|(_, g)| g.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
         assert!(scale > 0.0);
         // Nodes inside the Hertz circle and next to it, vertices and midpoints.
