@@ -323,7 +323,7 @@ pub const MIN_BUDGET_SHARE: f64 = 0.25;
 /// How a level's wall time grows with its unknowns, t ~ N^p, between consecutive levels
 /// solved from the level before (monolithic, goal-oriented): p was 1.07 and 1.09 on
 /// spin-0.5deg (124k -> 212k -> 464k unknowns) and 1.35, 1.18 and 1.21 on table2-ue2
-/// (60k -> 95k -> 186k -> 489k); the prediction of 1.2 was within 8 % of every level's
+/// (60k -> 95k -> 186k -> 489k); the prediction of 1.2 was within 9 % of every level's
 /// time from level 3 on. It does not see Newton's path: a level that needs more iterations
 /// or a continuation than the one before runs over it (spin-0.33deg's cut level: 305 s
 /// against 217 s; M = 1000, L = 20's level 4: 365 s against 147 s), and the deadline then
