@@ -77,8 +77,26 @@ pub struct Level {
     /// The share of its marked triangles' indicator the level refined when all of them would
     /// have exceeded `accuracy.max_unknowns` (None: all of them).
     pub budget_share: Option<f64>,
-    /// The budget that cut it: "accuracy.max_unknowns" or "accuracy.max_seconds".
-    pub cut_by: Option<&'static str>,
+    /// The budget that cut it (with `budget_share`).
+    pub cut_by: Option<Budget>,
+}
+
+/// The budget a level is cut to: `accuracy.max_unknowns`, or the unknowns the time left of
+/// `accuracy.max_seconds` allows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Budget {
+    Unknowns,
+    Seconds,
+}
+
+impl Budget {
+    /// The scene key that sets it.
+    pub fn key(self) -> &'static str {
+        match self {
+            Budget::Unknowns => "accuracy.max_unknowns",
+            Budget::Seconds => "accuracy.max_seconds",
+        }
+    }
 }
 
 /// A solved level kept for the next one: its setup, solution, dimensionless central film
@@ -132,7 +150,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     // How many of its marked triangles the present level refines when all of them would
     // exceed the budget, with the share of the indicator they carry, and the meshes tried
     // for it that were over the budget (count, unknowns).
-    let mut cut: Option<(usize, f64, &'static str)> = None;
+    let mut cut: Option<(usize, f64, Budget)> = None;
     let mut over: Vec<(usize, u64)> = Vec::new();
     loop {
         let scene = &own;
@@ -180,7 +198,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         100.0 * share
                     ));
                     field = Some(Arc::new(next_field(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), &m.largest(count), growth)));
-                    cut = Some((count, share, if by_time.is_some() { "accuracy.max_seconds" } else { "accuracy.max_unknowns" }));
+                    cut = Some((count, share, if by_time.is_some() { Budget::Seconds } else { Budget::Unknowns }));
                     continue;
                 }
             }
@@ -416,9 +434,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             "accuracy: level {k}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}; estimated error {}",
             level.contact_triangles,
             level.min_size,
-            level.budget_share.map_or(String::new(), |s| format!(
+            level.budget_share.zip(level.cut_by).map_or(String::new(), |(s, by)| format!(
                 " (cut to the budget {}: {:.0} % of the marked indicator)",
-                level.cut_by.unwrap_or("accuracy.max_unknowns"),
+                by.key(),
                 100.0 * s
             )),
             n_u + n_p + 1,
@@ -494,7 +512,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         }
         if cut_level {
             let why = match levels.last().and_then(|l| l.cut_by) {
-                Some("accuracy.max_seconds") => {
+                Some(Budget::Seconds) => {
                     format!(
                         "level {k} was cut to the time left of accuracy.max_seconds = {} s: the level after it would not end in it",
                         acc.max_seconds
@@ -640,7 +658,7 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
                 v["budget_share"] = json!(share);
             }
             if let Some(by) = l.cut_by {
-                v["cut_by"] = json!(by);
+                v["cut_by"] = json!(by.key());
             }
             v
         }).collect::<Vec<_>>(),

@@ -203,10 +203,9 @@ pub fn friction_gradient(fields: &dyn FaceSolution, s: &FrictionSetup, rules: &Q
     // A half domain doubles Fx and cancels Fz (friction_pass).
     let (cx, cz) = if fields.half() { (2.0, 0.0) } else { (1.0, 1.0) };
     for (t, rule) in &rules.0 {
-        let (t, rule) = (*t, rule.as_slice());
-        let tf = TriFields::new(fields, t);
+        let tf = TriFields::new(fields, *t);
         let area = crate::fem::p2tri::tri_area(&tf.v) * s.a * s.a;
-        let nodes = mesh.contact_tris[t];
+        let nodes = mesh.contact_tris[*t];
         for q in rule {
             let d = tf.inputs(q.l).stress_derivatives(s)?;
             let (n, dn) = (p2_tri_basis_bary(q.l), p2_tri_grads_bary(q.l, &tf.geo.grad_bary));
