@@ -74,11 +74,18 @@ pub struct Level {
     pub friction: Option<[f64; 2]>,
     /// Estimated errors (None on level 0).
     pub est: Option<Estimate>,
-    /// The share of its marked triangles' indicator the level refined when all of them would
-    /// have exceeded `accuracy.max_unknowns` (None: all of them).
-    pub budget_share: Option<f64>,
-    /// The budget that cut it (with `budget_share`).
-    pub cut_by: Option<Budget>,
+    /// How the level was cut to a budget (None: it refined all its marked triangles).
+    pub cut: Option<Cut>,
+}
+
+/// A level cut to a budget: it refined the `count` marked triangles of largest indicator,
+/// which carry `share` of the marked indicator, because all of them would have exceeded
+/// the budget `by`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cut {
+    pub count: usize,
+    pub share: f64,
+    pub by: Budget,
 }
 
 /// The budget a level is cut to: `accuracy.max_unknowns`, or the unknowns the time left of
@@ -147,10 +154,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     // Where the continuation of a level that failed before the raise of the gradient-jump
     // factor got, on the level's mesh: its solve with the factor raised goes on from there.
     let mut raised_from: Option<Reached> = None;
-    // How many of its marked triangles the present level refines when all of them would
-    // exceed the budget, with the share of the indicator they carry, and the meshes tried
-    // for it that were over the budget (count, unknowns).
-    let mut cut: Option<(usize, f64, Budget)> = None;
+    // How the present level is cut when all its marked triangles would exceed a budget, and
+    // the meshes tried for it that were over the budget (count, unknowns).
+    let mut cut: Option<Cut> = None;
     let mut over: Vec<(usize, u64)> = Vec::new();
     loop {
         let scene = &own;
@@ -189,7 +195,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             let ranked = prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| over.len() < MAX_CUTS);
             let hopeful = ranked.is_some() && Estimate::cut_could_reach(&levels, target);
             if let Some((m, marked)) = ranked.filter(|_| hopeful) {
-                over.push((cut.map_or(marked, |c| c.0), n));
+                over.push((cut.map_or(marked, |c| c.count), n));
                 let count = cut_count(before, &over, budget);
                 let share = m.indicator_share(count);
                 if share >= MIN_BUDGET_SHARE {
@@ -198,7 +204,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         100.0 * share
                     ));
                     field = Some(Arc::new(next_field(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), &m.largest(count), growth)));
-                    cut = Some((count, share, if by_time.is_some() { Budget::Seconds } else { Budget::Unknowns }));
+                    cut = Some(Cut { count, share, by: if by_time.is_some() { Budget::Seconds } else { Budget::Unknowns } });
                     continue;
                 }
             }
@@ -418,8 +424,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             pmax: st.pmax * ph,
             friction: friction.as_ref().map(|f| [f.fx, f.fz]),
             est: None,
-            budget_share: cut.map(|c| c.1),
-            cut_by: cut.take().map(|c| c.2),
+            cut: cut.take(),
         };
         over.clear();
         levels.push(level);
@@ -434,10 +439,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             "accuracy: level {k}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}; estimated error {}",
             level.contact_triangles,
             level.min_size,
-            level.budget_share.zip(level.cut_by).map_or(String::new(), |(s, by)| format!(
+            level.cut.map_or(String::new(), |c| format!(
                 " (cut to the budget {}: {:.0} % of the marked indicator)",
-                by.key(),
-                100.0 * s
+                c.by.key(),
+                100.0 * c.share
             )),
             n_u + n_p + 1,
             level.newton_iterations,
@@ -454,7 +459,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let reached = k >= 2 && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
         // A level cut to the budget is the last: the level after it would refine the rest of
         // its marking and more, over the budget, and would not be cut again.
-        let cut_level = levels.last().is_some_and(|l| l.budget_share.is_some());
+        let cut_level = levels.last().is_some_and(|l| l.cut.is_some());
         let last = reached || k == max_levels || cut_level;
         // The next level's marking, while this level's fields are at hand (not when it is the
         // last), and the speed exponents when asked for: both from one adjoint LU.
@@ -511,7 +516,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
         if cut_level {
-            let why = match levels.last().and_then(|l| l.cut_by) {
+            let why = match levels.last().and_then(|l| l.cut).map(|c| c.by) {
                 Some(Budget::Seconds) => {
                     format!(
                         "level {k} was cut to the time left of accuracy.max_seconds = {} s: the level after it would not end in it",
@@ -654,11 +659,9 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
                 v["fx"] = json!(fx);
                 v["fz"] = json!(fz);
             }
-            if let Some(share) = l.budget_share {
-                v["budget_share"] = json!(share);
-            }
-            if let Some(by) = l.cut_by {
-                v["cut_by"] = json!(by.key());
+            if let Some(c) = l.cut {
+                v["budget_share"] = json!(c.share);
+                v["cut_by"] = json!(c.by.key());
             }
             v
         }).collect::<Vec<_>>(),

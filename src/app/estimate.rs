@@ -40,7 +40,7 @@ impl Estimate {
         // A level cut to the budget refined part of what its marking asked for: its change
         // is not one of a sequence, so the estimate before it is carried over instead. A cut
         // that kept nearly all of it is a level of the sequence ([`FULL_LEVEL_SHARE`]).
-        let cut = levels.last().is_some_and(|l| l.budget_share.is_some_and(|s| s < FULL_LEVEL_SHARE));
+        let cut = levels.last().is_some_and(|l| l.cut.is_some_and(|c| c.share < FULL_LEVEL_SHARE));
         let e = sequences(levels)
             .iter()
             .map(|(q, scale)| if cut { estimate_after_cut(q, *scale) } else { estimate_scaled(q, *scale) })
@@ -177,6 +177,7 @@ fn estimate_after_cut(q: &[f64], scale: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::app::adapt::{Budget, Cut};
 
     /// A level with films `hc`, `hm` and friction `friction`, the rest unused by the estimate.
     fn level(hc: f64, hm: f64, friction: Option<[f64; 2]>) -> Level {
@@ -194,8 +195,7 @@ mod tests {
             pmax: 1.0,
             friction,
             est: None,
-            budget_share: None,
-            cut_by: None,
+            cut: None,
         }
     }
 
@@ -292,7 +292,7 @@ mod tests {
         let hm = [0.14461, 0.13818, 0.13869, 0.13790, 0.13779];
         let with = |share: Option<f64>| {
             let mut l: Vec<Level> = hm.iter().map(|&v| level(1.0, v, None)).collect();
-            l[4].budget_share = share;
+            l[4].cut = share.map(|share| Cut { count: 1, share, by: Budget::Unknowns });
             Estimate::of(&l).unwrap().hm
         };
         let q = hm.to_vec();
