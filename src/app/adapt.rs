@@ -45,6 +45,10 @@ use std::time::Instant;
 /// Smallest element size adaptive refinement makes (units of a): 16/2^12.
 pub const MIN_ADAPTIVE_SIZE: f64 = 16.0 / 4096.0;
 
+/// The failed steps a level's continuation ramp may take while the gradient-jump factor can
+/// still be raised: after them the level is solved again with the factor raised.
+const RAMP_FAILURES_BEFORE_THE_RAISE: usize = 2;
+
 /// Meshes tried for a level cut to the budget (each a fraction of a second at 600,000
 /// unknowns): a cut that still exceeds it is cut again from the meshes tried ([`cut_count`]).
 const MAX_CUTS: usize = 6;
@@ -255,7 +259,14 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     layout: &prev.setup.layout,
                     x: &prev.sol.x,
                 });
-                let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder, last_resorts, coarser };
+                // While the factor can be raised, a ramp gives up at its second failed step:
+                // the raised solve goes on from the furthest state the ramp converged at.
+                // M = 40, L = 15's 0.03125 a level failed four ramp steps at c_J = 0.01
+                // (alpha 25.6 -> 36.2 -> 39.5 GPa^-1 between its converged ones, 254 s),
+                // then converged with c_J = 1 in 26 iterations (48 s); docs/accuracy.md,
+                // "Newton on fine levels at high M and L".
+                let ramp_failures = raisable.then_some(RAMP_FAILURES_BEFORE_THE_RAISE);
+                let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder, last_resorts, ramp_failures, coarser };
                 // After the raise: first from the failed try's furthest state (its milder
                 // problem, on this same mesh), without the last resorts; if that fails, from
                 // the coarser level's state as before. At M = 1000, L = 20 the try with

@@ -145,11 +145,7 @@ pub(super) fn onward<'a>(ctx: &'a Context, scene: &Scene, solver: &EhlSolver<'a>
             let f = FieldsOnFace::new(&setup.mesh, &setup.layout, x);
             let p = |x: f64, z: f64| f.at(x, z).map_or(0.0, |v| v.0);
             let label = label(setup);
-            solver.solve_from(
-                ctx,
-                scene,
-                Start::Pressure { p: &p, hc: f.stats().hc, label: &label, plain: true, milder: None, last_resorts: true, coarser: None },
-            )
+            solver.solve_from(ctx, scene, Start::from_pressure(&p, f.stats().hc, &label))
         }
     }
 }
@@ -174,5 +170,9 @@ pub(super) fn from_reached<'a>(
     let ts = [r.t];
     let milder = Milder { parameter: r.parameter, ts: &ts, p: &p, hc, label };
     let coarser = same_mesh.then_some(Coarser { mesh: &setup.mesh, layout: &setup.layout, x: &r.x });
-    solver.solve_from(ctx, scene, Start::Pressure { p: &p, hc, label, plain: false, milder: Some(milder), last_resorts: false, coarser })
+    solver.solve_from(
+        ctx,
+        scene,
+        Start::Pressure { p: &p, hc, label, plain: false, milder: Some(milder), last_resorts: false, ramp_failures: None, coarser },
+    )
 }

@@ -152,11 +152,7 @@ impl EarlierRun {
         let p = |x: f64, z: f64| self.pressure_at(x * a, z * a) / ph;
         let label = format!("the pressure of {} ({} contact nodes)", self.dir.display(), self.mesh.contact_nodes.len());
         let hc = self.hc_m / scene.scales().film_scale();
-        solver.solve_from(
-            ctx,
-            scene,
-            crate::ehl::driver::Start::Pressure { p: &p, hc, label: &label, plain: true, milder: None, last_resorts: true, coarser: None },
-        )
+        solver.solve_from(ctx, scene, crate::ehl::driver::Start::from_pressure(&p, hc, &label))
     }
 
     /// The earlier pressure (Pa) at (x, z) in metres, by P2 interpolation; 0 outside the

@@ -406,7 +406,7 @@ impl Newton<'_> {
     }
 
     /// Ramps `h` from t (where `state` is converged) to the scene's problem at t = 1 by the
-    /// steps of [`RampSteps`]. Returns whether t = 1 converged, the last report, the last
+    /// `steps` ([`RampSteps`]). Returns whether t = 1 converged, the last report, the last
     /// converged state, and the values of t < 1 converged at (from the first t on).
     #[allow(clippy::type_complexity)]
     fn ramp(
@@ -416,9 +416,9 @@ impl Newton<'_> {
         mut t: f64,
         mut state: Vec<f64>,
         system: &mut dyn EhlProblem,
-        schedule: &[f64],
+        mut steps: RampSteps,
     ) -> Result<(bool, Option<SolveReport>, Vec<f64>, Vec<f64>), Error> {
-        let mut steps = RampSteps { ratio: h.ramp.ratio, schedule };
+        let failures = steps.failures_left;
         let mut last = None;
         let mut below = vec![t];
         while t < 1.0 {
@@ -434,6 +434,13 @@ impl Newton<'_> {
             }
             last = Some(r);
             if !converged && !steps.failed(t, next, planned) {
+                if steps.failures_left == Some(0) {
+                    self.note(format!(
+                        "{} continuation: {} failed steps, the most this solve allows (a cheaper remedy follows)",
+                        h.parameter.name(),
+                        failures.unwrap_or_default()
+                    ));
+                }
                 return Ok((false, last, state, below));
             }
         }
@@ -447,6 +454,8 @@ impl Newton<'_> {
 struct RampSteps<'s> {
     ratio: f64,
     schedule: &'s [f64],
+    /// The failed steps left before the ramp gives up (None: no such limit).
+    failures_left: Option<usize>,
 }
 
 impl RampSteps<'_> {
@@ -470,9 +479,16 @@ impl RampSteps<'_> {
     /// the step to alpha failed, and the square root of 2 gave alpha again). A failed
     /// scheduled step drops the schedule, and the ramp goes on by its own ratio from there;
     /// such a step may be below the smallest ratio once (the coarser level's path had small
-    /// steps). Returns false when the ramp gives up.
+    /// steps). Returns false when the ramp gives up: its ratio too small, or its failures
+    /// spent.
     fn failed(&mut self, t: f64, tried: f64, planned: bool) -> bool {
         self.ratio = (tried / t).sqrt();
+        if let Some(left) = self.failures_left.as_mut() {
+            *left = left.saturating_sub(1);
+            if *left == 0 {
+                return false;
+            }
+        }
         if planned {
             self.schedule = &[];
             true
@@ -582,7 +598,8 @@ pub(super) fn newton_with_continuation(
             }
             let Some((t, from)) = found else { continue };
             let first = from.clone();
-            let (done, r, xs, below) = nw.ramp(&base, &h, t, from, system, schedule)?;
+            let steps = RampSteps { ratio: h.ramp.ratio, schedule, failures_left: policy.ramp_failures };
+            let (done, r, xs, below) = nw.ramp(&base, &h, t, from, system, steps)?;
             if r.is_some() {
                 last = r;
             }
@@ -614,7 +631,8 @@ pub(super) fn newton_with_continuation(
     if let Some(from) = state.take_if(|_| staged) {
         let first = PENALTY_START / xi;
         let h = Homotopy { parameter: Parameter::Penalty(xi), ramp: Ramp { first, lowest: first, ratio: xi / PENALTY_START } };
-        let (done, r, xs, _) = nw.ramp(scene, &h, first, from, system, &[])?;
+        let steps = RampSteps { ratio: h.ramp.ratio, schedule: &[], failures_left: None };
+        let (done, r, xs, _) = nw.ramp(scene, &h, first, from, system, steps)?;
         if r.is_some() {
             last = r;
         }
@@ -658,7 +676,12 @@ mod tests {
 
     /// The values a ramp from t0 tries when a step from t to t' converges iff `ok(t, t')`.
     fn tried(t0: f64, ratio: f64, schedule: &[f64], ok: impl Fn(f64, f64) -> bool) -> (bool, Vec<f64>) {
-        let (mut steps, mut t, mut out) = (RampSteps { ratio, schedule }, t0, Vec::new());
+        tried_with(t0, ratio, schedule, None, ok)
+    }
+
+    /// The same, giving up after `failures` failed steps when given.
+    fn tried_with(t0: f64, ratio: f64, schedule: &[f64], failures: Option<usize>, ok: impl Fn(f64, f64) -> bool) -> (bool, Vec<f64>) {
+        let (mut steps, mut t, mut out) = (RampSteps { ratio, schedule, failures_left: failures }, t0, Vec::new());
         while t < 1.0 {
             let (next, planned) = steps.next(t);
             out.push(next);
@@ -690,6 +713,21 @@ mod tests {
         // Steps of 2, 2^(1/2), 2^(1/4), 2^(1/8) and then the ramp gives up.
         let (done, t) = tried(0.5, 2.0, &[], |_, _| false);
         assert!(!done && t.len() == 4, "{t:?}");
+    }
+
+    #[test]
+    fn a_ramp_with_a_failure_limit_gives_up_at_it() {
+        let r2 = 2f64.sqrt();
+        // Converging only by steps up to 1.3 from 1/2: the second failure ends the ramp.
+        let (done, t) = tried_with(0.5, 2.0, &[], Some(2), |t, n| n / t <= 1.3);
+        assert!(!done && t.len() == 2 && (t[1] - 0.5 * r2).abs() < 1e-12, "{t:?}");
+        // Failures between converged steps count too: 1 fails, 1/sqrt(2) converges, 1 fails.
+        let (done, t) = tried_with(0.5, 2.0, &[], Some(2), |_, n| n < 0.8);
+        assert!(!done && t == vec![1.0, 0.5 * r2, 1.0], "{t:?}");
+        // One failure and then convergence: the limit does not bind.
+        assert_eq!(tried_with(0.5, 2.0, &[], Some(2), |t, n| n / t <= 1.5), (true, vec![1.0, 0.5 * r2, 1.0]));
+        // Without the limit the same ramp as before.
+        assert_eq!(tried_with(0.5, 2.0, &[], None, |t, n| n / t <= 1.3), tried(0.5, 2.0, &[], |t, n| n / t <= 1.3));
     }
 
     #[test]

@@ -84,6 +84,9 @@ pub(super) struct Policy {
     /// The load and speed continuations follow the tilt and pressure-viscosity ones
     /// ([`Start::last_resorts`]).
     pub(super) last_resorts: bool,
+    /// The failed steps a continuation's ramp may take before it gives up
+    /// ([`Start::ramp_failures`]; None: until its ratio falls below 1.05).
+    pub(super) ramp_failures: Option<usize>,
 }
 
 impl Policy {
@@ -116,6 +119,7 @@ impl Policy {
             // failed: it goes straight to the continuation.
             plain_first: hertz || !attempt.continues,
             last_resorts: start.last_resorts(),
+            ramp_failures: start.ramp_failures(),
         }
     }
 }
@@ -266,7 +270,16 @@ mod tests {
     #[test]
     fn another_meshs_pressure_continues_from_itself_after_a_short_plain_newton() {
         let p = |_: f64, _: f64| 0.0;
-        let coarse = Start::Pressure { p: &p, hc: 0.5, label: "level 0", plain: true, milder: None, last_resorts: true, coarser: None };
+        let coarse = Start::Pressure {
+            p: &p,
+            hc: 0.5,
+            label: "level 0",
+            plain: true,
+            milder: None,
+            last_resorts: true,
+            ramp_failures: None,
+            coarser: None,
+        };
         for monolithic in [true, false] {
             let ladder = Attempt::ladder(&coarse, monolithic);
             assert_eq!(ladder.len(), 2);
@@ -279,7 +292,16 @@ mod tests {
             assert!(cont.bt_after_domain_error() && !plain.bt_after_domain_error());
         }
         // After a coarser level that needed the continuation: the continuation at once.
-        let hard = Start::Pressure { p: &p, hc: 0.5, label: "level 1", plain: false, milder: None, last_resorts: true, coarser: None };
+        let hard = Start::Pressure {
+            p: &p,
+            hc: 0.5,
+            label: "level 1",
+            plain: false,
+            milder: None,
+            last_resorts: true,
+            ramp_failures: None,
+            coarser: None,
+        };
         assert_eq!(Attempt::ladder(&hard, true), vec![Attempt { reuse_lu: true, continues: true }]);
         assert_eq!(Attempt::ladder(&hard, false), vec![Attempt { reuse_lu: false, continues: true }]);
         // A sweep's previous point: the LU reuse on the monolithic coupling, then exact Newton.
@@ -290,7 +312,16 @@ mod tests {
         let hertz = Policy::for_start(&Start::Hertz, Attempt::PLAIN);
         assert!(hertz.continues && hertz.plain_first && !hertz.reuses_lu && hertz.last_resorts);
         // A caller with a remedy of its own: the continuation without the last resorts.
-        let own = Start::Pressure { p: &p, hc: 0.5, label: "level 2", plain: false, milder: None, last_resorts: false, coarser: None };
+        let own = Start::Pressure {
+            p: &p,
+            hc: 0.5,
+            label: "level 2",
+            plain: false,
+            milder: None,
+            last_resorts: false,
+            ramp_failures: None,
+            coarser: None,
+        };
         let ladder = Attempt::ladder(&own, true);
         assert!(ladder.iter().all(|a| !Policy::for_start(&own, *a).last_resorts));
         assert!(!own.last_resorts() && hard.last_resorts());

@@ -28,7 +28,9 @@ pub enum Start<'s> {
     /// itself needed the continuation: see [`super::policy::Attempt::ladder`]). With
     /// `last_resorts` false the load and speed continuations and the Hertz start are not
     /// tried after the continuations nearest the scene (tilt, pressure-viscosity) fail:
-    /// the caller has a remedy of its own to try first.
+    /// the caller has a remedy of its own to try first. `ramp_failures`: the failed steps a
+    /// continuation's ramp may take before it gives up (None: until its step ratio falls
+    /// below 1.05), for a caller whose own remedy costs less than a long ramp.
     /// `coarser`: the coarser level's own state, when it was solved on the monolithic
     /// coupling: its displacement interpolated at this mesh's nodes replaces the elastic
     /// solve under the pressure on a monolithic level ([`coarser_displacement`]).
@@ -39,6 +41,7 @@ pub enum Start<'s> {
         plain: bool,
         milder: Option<Milder<'s>>,
         last_resorts: bool,
+        ramp_failures: Option<usize>,
         coarser: Option<Coarser<'s>>,
     },
 }
@@ -65,6 +68,12 @@ pub struct Milder<'s> {
 }
 
 impl<'s> Start<'s> {
+    /// Another mesh's pressure `p` with central film `hc`, named `label`, with no coarser
+    /// state: plain Newton first, then every continuation and the Hertz start.
+    pub fn from_pressure(p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str) -> Start<'s> {
+        Start::Pressure { p, hc, label, plain: true, milder: None, last_resorts: true, ramp_failures: None, coarser: None }
+    }
+
     /// The starting pressure P(X, Z) and central film of a start that is not a previous
     /// state: the Hertz pressure with Hamrock-Dowson's hc, or the given field.
     pub(super) fn pressure(&self, scene: &Scene) -> (&'s dyn Fn(f64, f64) -> f64, f64) {
@@ -96,6 +105,14 @@ impl<'s> Start<'s> {
         match *self {
             Start::Pressure { last_resorts, .. } => last_resorts,
             _ => true,
+        }
+    }
+
+    /// The failed steps a ramp may take (see [`Start::Pressure`]).
+    pub(super) fn ramp_failures(&self) -> Option<usize> {
+        match *self {
+            Start::Pressure { ramp_failures, .. } => ramp_failures,
+            _ => None,
         }
     }
 
