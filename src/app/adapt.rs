@@ -264,7 +264,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 // M = 40, L = 15's 0.03125 a level failed four ramp steps at c_J = 0.01
                 // (alpha 25.6 -> 36.2 -> 39.5 GPa^-1 between its converged ones, 254 s),
                 // then converged with c_J = 1 in 26 iterations (48 s); docs/accuracy.md,
-                // "Newton on fine levels at high M and L".
+                // "The ramp's second failure".
                 let ramp_failures = raisable.then_some(RAMP_FAILURES_BEFORE_THE_RAISE);
                 let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder, last_resorts, ramp_failures, coarser };
                 // After the raise: first from the failed try's furthest state (its milder
