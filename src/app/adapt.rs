@@ -33,7 +33,7 @@ use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
 use crate::case::Scene;
 use crate::collective;
-use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, Start};
+use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, RampLimits, Start};
 use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
 use crate::friction::pass::FrictionResult;
@@ -44,10 +44,6 @@ use std::time::Instant;
 
 /// Smallest element size adaptive refinement makes (units of a): 16/2^12.
 pub const MIN_ADAPTIVE_SIZE: f64 = 16.0 / 4096.0;
-
-/// The failed steps a level's continuation ramp may take while the gradient-jump factor can
-/// still be raised: after them the level is solved again with the factor raised.
-const RAMP_FAILURES_BEFORE_THE_RAISE: usize = 2;
 
 /// Meshes tried for a level cut to the budget (each a fraction of a second at 600,000
 /// unknowns): a cut that still exceeds it is cut again from the meshes tried ([`cut_count`]).
@@ -263,10 +259,16 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 // the raised solve goes on from the furthest state the ramp converged at.
                 // M = 40, L = 15's 0.03125 a level failed four ramp steps at c_J = 0.01
                 // (alpha 25.6 -> 36.2 -> 39.5 GPa^-1 between its converged ones, 254 s),
-                // then converged with c_J = 1 in 26 iterations (48 s); docs/accuracy.md,
-                // "The ramp's second failure".
-                let ramp_failures = raisable.then_some(RAMP_FAILURES_BEFORE_THE_RAISE);
-                let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder, last_resorts, ramp_failures, coarser };
+                // then converged with c_J = 1 in 26 iterations (48 s). Once it is raised,
+                // only the last resorts are left, and the ramp takes smaller steps before it
+                // gives up ([`RampLimits::PATIENT`]); docs/accuracy.md, "The ramp's second
+                // failure".
+                let ramp = match (raisable, scene.reynolds.gradient_jump >= RAISED_GRADIENT_JUMP) {
+                    (true, _) => RampLimits::BEFORE_A_REMEDY,
+                    (false, true) => RampLimits::PATIENT,
+                    (false, false) => RampLimits::DEFAULT,
+                };
+                let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder, last_resorts, ramp, coarser };
                 // After the raise: first from the failed try's furthest state (its milder
                 // problem, on this same mesh), without the last resorts; if that fails, from
                 // the coarser level's state as before. At M = 1000, L = 20 the try with

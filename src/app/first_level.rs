@@ -7,7 +7,7 @@ use super::marking::{field_of_sizes, longest_edges, next_field, within_bands, wi
 use super::Context;
 use crate::case::Scene;
 use crate::collective;
-use crate::ehl::driver::{Coarser, EhlSolution, EhlSolver, Milder, Start};
+use crate::ehl::driver::{Coarser, EhlSolution, EhlSolver, Milder, RampLimits, Start};
 use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
 use crate::mesh::size_field::SizeField;
@@ -170,9 +170,12 @@ pub(super) fn from_reached<'a>(
     let ts = [r.t];
     let milder = Milder { parameter: r.parameter, ts: &ts, p: &p, hc, label };
     let coarser = same_mesh.then_some(Coarser { mesh: &setup.mesh, layout: &setup.layout, x: &r.x });
+    // A level solved again on its own mesh has had the gradient-jump factor raised: no
+    // remedy is left but the last resorts, and its ramp takes smaller steps before it gives up.
+    let ramp = if same_mesh { RampLimits::PATIENT } else { RampLimits::DEFAULT };
     solver.solve_from(
         ctx,
         scene,
-        Start::Pressure { p: &p, hc, label, plain: false, milder: Some(milder), last_resorts: false, ramp_failures: None, coarser },
+        Start::Pressure { p: &p, hc, label, plain: false, milder: Some(milder), last_resorts: false, ramp, coarser },
     )
 }

@@ -8,6 +8,7 @@
 use super::diagnostics::Collapse;
 use super::policy::{newton_atol, set_newton_linear_solver, Policy, INTERMEDIATE_ATOL};
 use super::problem::{lambda_bar, lubricant, penalty, velocity_field};
+use super::start::RampLimits;
 use crate::case::Scene;
 use crate::context::Context;
 use crate::ehl::system::EhlProblem;
@@ -456,12 +457,11 @@ struct RampSteps<'s> {
     schedule: &'s [f64],
     /// The failed steps left before the ramp gives up (None: no such limit).
     failures_left: Option<usize>,
+    /// A ramp gives up when a failed step would be followed by a ratio below this.
+    smallest_ratio: f64,
 }
 
 impl RampSteps<'_> {
-    /// A ramp gives up when a failed step would be followed by a ratio below this.
-    const SMALLEST_RATIO: f64 = 1.05;
-
     /// The value to try from t, and whether it is a value of the schedule.
     fn next(&self, t: f64) -> (f64, bool) {
         // Within round-off of the end is the end (heavy-3gpa's load ramp by factors of
@@ -493,7 +493,7 @@ impl RampSteps<'_> {
             self.schedule = &[];
             true
         } else {
-            self.ratio >= Self::SMALLEST_RATIO
+            self.ratio >= self.smallest_ratio
         }
     }
 }
@@ -598,7 +598,12 @@ pub(super) fn newton_with_continuation(
             }
             let Some((t, from)) = found else { continue };
             let first = from.clone();
-            let steps = RampSteps { ratio: h.ramp.ratio, schedule, failures_left: policy.ramp_failures };
+            let steps = RampSteps {
+                ratio: h.ramp.ratio,
+                schedule,
+                failures_left: policy.ramp.failures,
+                smallest_ratio: policy.ramp.smallest_ratio,
+            };
             let (done, r, xs, below) = nw.ramp(&base, &h, t, from, system, steps)?;
             if r.is_some() {
                 last = r;
@@ -631,7 +636,8 @@ pub(super) fn newton_with_continuation(
     if let Some(from) = state.take_if(|_| staged) {
         let first = PENALTY_START / xi;
         let h = Homotopy { parameter: Parameter::Penalty(xi), ramp: Ramp { first, lowest: first, ratio: xi / PENALTY_START } };
-        let steps = RampSteps { ratio: h.ramp.ratio, schedule: &[], failures_left: None };
+        let steps =
+            RampSteps { ratio: h.ramp.ratio, schedule: &[], failures_left: None, smallest_ratio: RampLimits::DEFAULT.smallest_ratio };
         let (done, r, xs, _) = nw.ramp(scene, &h, first, from, system, steps)?;
         if r.is_some() {
             last = r;
@@ -672,16 +678,17 @@ fn new_snes(comm: petsc::ffi::MPI_Comm) -> Result<Snes, Error> {
 
 #[cfg(test)]
 mod tests {
-    use super::{homotopies, Parameter, RampSteps};
+    use super::{homotopies, Parameter, RampLimits, RampSteps};
 
     /// The values a ramp from t0 tries when a step from t to t' converges iff `ok(t, t')`.
     fn tried(t0: f64, ratio: f64, schedule: &[f64], ok: impl Fn(f64, f64) -> bool) -> (bool, Vec<f64>) {
-        tried_with(t0, ratio, schedule, None, ok)
+        tried_with(t0, ratio, schedule, RampLimits::DEFAULT, ok)
     }
 
-    /// The same, giving up after `failures` failed steps when given.
-    fn tried_with(t0: f64, ratio: f64, schedule: &[f64], failures: Option<usize>, ok: impl Fn(f64, f64) -> bool) -> (bool, Vec<f64>) {
-        let (mut steps, mut t, mut out) = (RampSteps { ratio, schedule, failures_left: failures }, t0, Vec::new());
+    /// The same, with the ramp's `limits`.
+    fn tried_with(t0: f64, ratio: f64, schedule: &[f64], limits: RampLimits, ok: impl Fn(f64, f64) -> bool) -> (bool, Vec<f64>) {
+        let (mut steps, mut t, mut out) =
+            (RampSteps { ratio, schedule, failures_left: limits.failures, smallest_ratio: limits.smallest_ratio }, t0, Vec::new());
         while t < 1.0 {
             let (next, planned) = steps.next(t);
             out.push(next);
@@ -719,15 +726,26 @@ mod tests {
     fn a_ramp_with_a_failure_limit_gives_up_at_it() {
         let r2 = 2f64.sqrt();
         // Converging only by steps up to 1.3 from 1/2: the second failure ends the ramp.
-        let (done, t) = tried_with(0.5, 2.0, &[], Some(2), |t, n| n / t <= 1.3);
+        let (done, t) = tried_with(0.5, 2.0, &[], RampLimits::BEFORE_A_REMEDY, |t, n| n / t <= 1.3);
         assert!(!done && t.len() == 2 && (t[1] - 0.5 * r2).abs() < 1e-12, "{t:?}");
         // Failures between converged steps count too: 1 fails, 1/sqrt(2) converges, 1 fails.
-        let (done, t) = tried_with(0.5, 2.0, &[], Some(2), |_, n| n < 0.8);
+        let (done, t) = tried_with(0.5, 2.0, &[], RampLimits::BEFORE_A_REMEDY, |_, n| n < 0.8);
         assert!(!done && t == vec![1.0, 0.5 * r2, 1.0], "{t:?}");
         // One failure and then convergence: the limit does not bind.
-        assert_eq!(tried_with(0.5, 2.0, &[], Some(2), |t, n| n / t <= 1.5), (true, vec![1.0, 0.5 * r2, 1.0]));
+        assert_eq!(tried_with(0.5, 2.0, &[], RampLimits::BEFORE_A_REMEDY, |t, n| n / t <= 1.5), (true, vec![1.0, 0.5 * r2, 1.0]));
         // Without the limit the same ramp as before.
-        assert_eq!(tried_with(0.5, 2.0, &[], None, |t, n| n / t <= 1.3), tried(0.5, 2.0, &[], |t, n| n / t <= 1.3));
+        assert_eq!(tried_with(0.5, 2.0, &[], RampLimits::DEFAULT, |t, n| n / t <= 1.3), tried(0.5, 2.0, &[], |t, n| n / t <= 1.3));
+    }
+
+    #[test]
+    fn a_patient_ramp_takes_smaller_steps_before_it_gives_up() {
+        // M = 20, L = 20 with c_J = 1: from alpha 62.59 of 68.25 GPa^-1 the step to alpha
+        // fails and only a step of at most 1.05 converges.
+        let (t0, r) = (62.59 / 68.25, (68.25f64 / 62.59).sqrt());
+        let ok = |t: f64, n: f64| n / t <= 1.05;
+        assert_eq!(tried_with(t0, 2.0, &[], RampLimits::DEFAULT, ok), (false, vec![1.0]));
+        let (done, t) = tried_with(t0, 2.0, &[], RampLimits::PATIENT, ok);
+        assert!(done && t.len() == 3 && (t[1] - t0 * r).abs() < 1e-12, "{t:?}");
     }
 
     #[test]

@@ -84,9 +84,8 @@ pub(super) struct Policy {
     /// The load and speed continuations follow the tilt and pressure-viscosity ones
     /// ([`Start::last_resorts`]).
     pub(super) last_resorts: bool,
-    /// The failed steps a continuation's ramp may take before it gives up
-    /// ([`Start::ramp_failures`]; None: until its ratio falls below 1.05).
-    pub(super) ramp_failures: Option<usize>,
+    /// When a continuation's ramp gives up ([`Start::ramp`]).
+    pub(super) ramp: super::start::RampLimits,
 }
 
 impl Policy {
@@ -119,7 +118,7 @@ impl Policy {
             // failed: it goes straight to the continuation.
             plain_first: hertz || !attempt.continues,
             last_resorts: start.last_resorts(),
-            ramp_failures: start.ramp_failures(),
+            ramp: start.ramp(),
         }
     }
 }
@@ -277,7 +276,7 @@ mod tests {
             plain: true,
             milder: None,
             last_resorts: true,
-            ramp_failures: None,
+            ramp: crate::ehl::driver::RampLimits::DEFAULT,
             coarser: None,
         };
         for monolithic in [true, false] {
@@ -299,7 +298,7 @@ mod tests {
             plain: false,
             milder: None,
             last_resorts: true,
-            ramp_failures: None,
+            ramp: crate::ehl::driver::RampLimits::DEFAULT,
             coarser: None,
         };
         assert_eq!(Attempt::ladder(&hard, true), vec![Attempt { reuse_lu: true, continues: true }]);
@@ -319,7 +318,7 @@ mod tests {
             plain: false,
             milder: None,
             last_resorts: false,
-            ramp_failures: None,
+            ramp: crate::ehl::driver::RampLimits::DEFAULT,
             coarser: None,
         };
         let ladder = Attempt::ladder(&own, true);

@@ -28,9 +28,8 @@ pub enum Start<'s> {
     /// itself needed the continuation: see [`super::policy::Attempt::ladder`]). With
     /// `last_resorts` false the load and speed continuations and the Hertz start are not
     /// tried after the continuations nearest the scene (tilt, pressure-viscosity) fail:
-    /// the caller has a remedy of its own to try first. `ramp_failures`: the failed steps a
-    /// continuation's ramp may take before it gives up (None: until its step ratio falls
-    /// below 1.05), for a caller whose own remedy costs less than a long ramp.
+    /// the caller has a remedy of its own to try first. `ramp`: when a continuation's ramp
+    /// gives up ([`RampLimits`]).
     /// `coarser`: the coarser level's own state, when it was solved on the monolithic
     /// coupling: its displacement interpolated at this mesh's nodes replaces the elastic
     /// solve under the pressure on a monolithic level ([`coarser_displacement`]).
@@ -41,9 +40,33 @@ pub enum Start<'s> {
         plain: bool,
         milder: Option<Milder<'s>>,
         last_resorts: bool,
-        ramp_failures: Option<usize>,
+        ramp: RampLimits,
         coarser: Option<Coarser<'s>>,
     },
+}
+
+/// When a continuation's ramp gives up: after `failures` failed steps (None: no such
+/// limit), or when a failed step would be followed by a factor below `smallest_ratio`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RampLimits {
+    pub failures: Option<usize>,
+    pub smallest_ratio: f64,
+}
+
+impl RampLimits {
+    /// Steps down to a factor of 1.05: below it a ramp crawls (M = 100, L = 20's 0.125 a
+    /// level with a floor of 1.005 converged after 179 Newton iterations, where the zone's
+    /// mesh then took 30).
+    pub const DEFAULT: RampLimits = RampLimits { failures: None, smallest_ratio: 1.05 };
+    /// For a caller whose own remedy costs less than a long ramp: give up at the second
+    /// failed step.
+    pub const BEFORE_A_REMEDY: RampLimits = RampLimits { failures: Some(2), smallest_ratio: 1.05 };
+    /// For a solve with no remedy left but the last resorts, which have never converged
+    /// from a coarser level's pressure: steps down to a factor of 1.01. The step from
+    /// 62.6 to 68.3 GPa^-1 (a factor of 1.09) failed on raised levels of M = 20, L = 20 and
+    /// M = 50, L = 20, and the ramp gave up at its square root 1.044; at M = 100, L = 20
+    /// 62.59 -> 65.36 -> 68.25 converged in 8 and 7 iterations.
+    pub const PATIENT: RampLimits = RampLimits { failures: None, smallest_ratio: 1.01 };
 }
 
 /// A coarser level's converged monolithic state (U, P and H0 in its layout) on its mesh.
@@ -71,7 +94,7 @@ impl<'s> Start<'s> {
     /// Another mesh's pressure `p` with central film `hc`, named `label`, with no coarser
     /// state: plain Newton first, then every continuation and the Hertz start.
     pub fn from_pressure(p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str) -> Start<'s> {
-        Start::Pressure { p, hc, label, plain: true, milder: None, last_resorts: true, ramp_failures: None, coarser: None }
+        Start::Pressure { p, hc, label, plain: true, milder: None, last_resorts: true, ramp: RampLimits::DEFAULT, coarser: None }
     }
 
     /// The starting pressure P(X, Z) and central film of a start that is not a previous
@@ -108,11 +131,11 @@ impl<'s> Start<'s> {
         }
     }
 
-    /// The failed steps a ramp may take (see [`Start::Pressure`]).
-    pub(super) fn ramp_failures(&self) -> Option<usize> {
+    /// When a continuation's ramp gives up (see [`Start::Pressure`]).
+    pub(super) fn ramp(&self) -> RampLimits {
         match *self {
-            Start::Pressure { ramp_failures, .. } => ramp_failures,
-            _ => None,
+            Start::Pressure { ramp, .. } => ramp,
+            _ => RampLimits::DEFAULT,
         }
     }
 
