@@ -461,7 +461,12 @@ struct RampSteps<'s> {
     smallest_ratio: f64,
 }
 
-impl RampSteps<'_> {
+impl<'s> RampSteps<'s> {
+    /// Steps by `ratio` through `schedule`, within `limits`.
+    fn new(ratio: f64, schedule: &'s [f64], limits: RampLimits) -> RampSteps<'s> {
+        RampSteps { ratio, schedule, failures_left: limits.failures, smallest_ratio: limits.smallest_ratio }
+    }
+
     /// The value to try from t, and whether it is a value of the schedule.
     fn next(&self, t: f64) -> (f64, bool) {
         // Within round-off of the end is the end (heavy-3gpa's load ramp by factors of
@@ -598,13 +603,7 @@ pub(super) fn newton_with_continuation(
             }
             let Some((t, from)) = found else { continue };
             let first = from.clone();
-            let steps = RampSteps {
-                ratio: h.ramp.ratio,
-                schedule,
-                failures_left: policy.ramp.failures,
-                smallest_ratio: policy.ramp.smallest_ratio,
-            };
-            let (done, r, xs, below) = nw.ramp(&base, &h, t, from, system, steps)?;
+            let (done, r, xs, below) = nw.ramp(&base, &h, t, from, system, RampSteps::new(h.ramp.ratio, schedule, policy.ramp))?;
             if r.is_some() {
                 last = r;
             }
@@ -636,9 +635,7 @@ pub(super) fn newton_with_continuation(
     if let Some(from) = state.take_if(|_| staged) {
         let first = PENALTY_START / xi;
         let h = Homotopy { parameter: Parameter::Penalty(xi), ramp: Ramp { first, lowest: first, ratio: xi / PENALTY_START } };
-        let steps =
-            RampSteps { ratio: h.ramp.ratio, schedule: &[], failures_left: None, smallest_ratio: RampLimits::DEFAULT.smallest_ratio };
-        let (done, r, xs, _) = nw.ramp(scene, &h, first, from, system, steps)?;
+        let (done, r, xs, _) = nw.ramp(scene, &h, first, from, system, RampSteps::new(h.ramp.ratio, &[], RampLimits::DEFAULT))?;
         if r.is_some() {
             last = r;
         }
@@ -687,8 +684,7 @@ mod tests {
 
     /// The same, with the ramp's `limits`.
     fn tried_with(t0: f64, ratio: f64, schedule: &[f64], limits: RampLimits, ok: impl Fn(f64, f64) -> bool) -> (bool, Vec<f64>) {
-        let (mut steps, mut t, mut out) =
-            (RampSteps { ratio, schedule, failures_left: limits.failures, smallest_ratio: limits.smallest_ratio }, t0, Vec::new());
+        let (mut steps, mut t, mut out) = (RampSteps::new(ratio, schedule, limits), t0, Vec::new());
         while t < 1.0 {
             let (next, planned) = steps.next(t);
             out.push(next);

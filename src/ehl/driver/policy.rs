@@ -269,16 +269,7 @@ mod tests {
     #[test]
     fn another_meshs_pressure_continues_from_itself_after_a_short_plain_newton() {
         let p = |_: f64, _: f64| 0.0;
-        let coarse = Start::Pressure {
-            p: &p,
-            hc: 0.5,
-            label: "level 0",
-            plain: true,
-            milder: None,
-            last_resorts: true,
-            ramp: crate::ehl::driver::RampLimits::DEFAULT,
-            coarser: None,
-        };
+        let coarse = Start::from_pressure(&p, 0.5, "level 0");
         for monolithic in [true, false] {
             let ladder = Attempt::ladder(&coarse, monolithic);
             assert_eq!(ladder.len(), 2);
