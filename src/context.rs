@@ -104,6 +104,7 @@ const MAY_BE_NULL: &[&str] = &[
     "spin_centre_z_m",
     "hc_hamrock_dowson_m",
     "hm_hamrock_dowson_m",
+    "hc_nijenbanning_m",
     "moes",
     "entrainment_speed_m_s",
     "snes_reason",

@@ -244,6 +244,9 @@ pub fn post_point(
         st.pmax * ph,
         load_error
     ));
+    if let Some(line) = formulas_line(scene, st.hc * hs, st.hm * hs) {
+        ctx.log(line);
+    }
     let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
     let mut res =
         PointResult { hc: st.hc * hs, hm: st.hm * hs, pmax: st.pmax * ph, load_error, fx: None, fz: None, profile_x0: Vec::new() };
@@ -388,6 +391,7 @@ pub fn post_point(
             h0_m: st.h0 * hs,
             hc_hamrock_dowson_m: hd.map(|h| h.central_film_thickness()),
             hm_hamrock_dowson_m: hd.map(|h| h.minimum_film_thickness()),
+            hc_nijenbanning_m: scene.nijenbanning_hc(),
         },
         pressure: PressureSummary {
             pmax_pa: st.pmax * ph,
@@ -570,4 +574,21 @@ impl FaceSolution for crate::ehl::post::FieldsOnFace<'_> {
     fn locate(&self, x: f64, z: f64) -> Option<(usize, [f64; 3])> {
         crate::ehl::post::FieldsOnFace::locate(self, x, z)
     }
+}
+
+/// The film formulas beside the result, each with the result's difference from it: a user
+/// comparing with a formula sees the formula's own spread (docs/validation.md) named, not
+/// an error of this solution. None when the scene has no finite, positive formula film
+/// (rigid or isoviscous solids).
+fn formulas_line(scene: &Scene, hc: f64, hm: f64) -> Option<String> {
+    let ok = |v: f64| v.is_finite() && v > 0.0;
+    let hd = scene.hamrock_dowson().filter(|h| ok(h.central_film_thickness()) && ok(h.minimum_film_thickness()))?;
+    let d = |x: f64, f: f64| 100.0 * (x / f - 1.0);
+    let (c, m) = (hd.central_film_thickness(), hd.minimum_film_thickness());
+    let nvm = scene.nijenbanning_hc().map_or(String::new(), |n| format!("; Nijenbanning-Venner-Moes hc {n:.4e} m ({:+.1} %)", d(hc, n)));
+    Some(format!(
+        "film formulas (curve fits of a few to tens of per cent, not checks; the result's difference in brackets): Hamrock-Dowson hc {c:.4e} m ({:+.1} %), hm {m:.4e} m ({:+.1} %){nvm}",
+        d(hc, c),
+        d(hm, m)
+    ))
 }

@@ -221,6 +221,19 @@ fn physics_helpers() {
     let hd = s.hamrock_dowson().unwrap().central_film_thickness();
     assert!((hd * 1e6 - 0.52).abs() < 0.01);
     assert!(rel(s.moes().unwrap().w, 1.015625e-6) < 1e-6);
+    // NVM is a fit for Barus, incompressible lubricants only; here (M, L) = (366.0, 7.459)
+    // and its H = 3.5881, so hc = H R sqrt(2U) = 0.56687 um (computed by hand from the
+    // groups of the scene).
+    assert!(s.nijenbanning_hc().is_none());
+    let b = parse_scene(
+        &paper_with("viscosity = \"roelands\"", "viscosity = \"barus\"")
+            .replace("\"dowson-higginson\"", "\"incompressible\"")
+            .replace("roelands_reference_pressure = 1.96e8\n", "")
+            .replace("roelands_exponent = 0.8591\n", ""),
+        "x",
+    )
+    .unwrap();
+    assert!(rel(b.nijenbanning_hc().unwrap(), 0.566873e-6) < 1e-5, "{:?}", b.nijenbanning_hc());
     // Uniform kinematics and derived z_R.
     let u = parse_scene(
         &paper_with("kinematics = \"spin\"", "kinematics = \"uniform\"")

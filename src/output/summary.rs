@@ -91,8 +91,9 @@ pub struct MeshSummary {
     pub max_aspect_ratio: Option<f64>,
 }
 
-/// Film thickness (m): central, minimum and where, the film constant h0, and Hamrock and
-/// Dowson's formulas for comparison.
+/// Film thickness (m): central, minimum and where, the film constant h0, and the curve fits
+/// of Hamrock and Dowson and of Nijenbanning, Venner and Moes for comparison (fits to
+/// numerical films of their day, not checks of this one: docs/validation.md).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct FilmSummary {
     #[serde(deserialize_with = "nan_if_null")]
@@ -107,6 +108,10 @@ pub struct FilmSummary {
     pub h0_m: f64,
     pub hc_hamrock_dowson_m: Option<f64>,
     pub hm_hamrock_dowson_m: Option<f64>,
+    /// The central film of Nijenbanning, Venner and Moes (1994), a fit to circular-contact
+    /// films in Moes' groups (absent from summaries written before it was reported).
+    #[serde(default)]
+    pub hc_nijenbanning_m: Option<f64>,
 }
 
 /// Pressure (Pa): maximum and where, minimum of the field and of the nodes, and the load

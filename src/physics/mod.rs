@@ -7,7 +7,7 @@
 //!   Newton Jacobian.
 //! - [`scales`]: the Hertzian scaling used by the solver (X = x/a, P = p/p_H,
 //!   H = h R/a^2) and the Moes dimensionless groups M, L.
-//! - [`film_formulas`]: Hamrock-Dowson film-thickness regression formulas (references).
+//! - [`film_formulas`]: the film-thickness curve fits of Hamrock-Dowson and Nijenbanning-Venner-Moes (references).
 //! - [`kinematics`]: surface velocities of ball B and disc D under rolling, sliding and spin.
 //!
 //! All functions take and return SI units unless their name or doc says "dimensionless".
