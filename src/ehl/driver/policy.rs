@@ -229,6 +229,16 @@ pub fn set_newton_defaults(target: f64) -> petsc::Result<()> {
     Ok(())
 }
 
+/// MUMPS's block low-rank dropping parameter (`-mat_mumps_cntl_7`) of the monolithic LU that
+/// GMRES is preconditioned with. The low-rank blocks of the fronts are compressed to this
+/// relative accuracy: the factorisation is cheaper and smaller, and GMRES, which corrects a
+/// three-step-old LU anyway, takes the same Newton steps. table2-ue2 at target 0.005 (2
+/// ranks, the same films and estimates to 6 digits): 148 s and 4.3 GB per rank against
+/// 187 s and 5.3 GB with the full-rank LU (medians of 3). Single runs of other values: 1e-6
+/// 164 s (1e-5: 138 s); 1e-4 142 s, 3.8 GB, one Newton step more on level 3; 1e-3 146 s,
+/// two more on level 4. docs/performance.md, "Block low-rank LU under GMRES".
+pub const BLR_DROPPING: &str = "1e-5";
+
 /// The linear solve of a Newton step (each overridable by PETSc options).
 ///
 /// `reuse_lu` (the monolithic coupling from a start near the solution, see
@@ -247,14 +257,24 @@ pub fn set_newton_defaults(target: f64) -> petsc::Result<()> {
 /// ScaLAPACK LU of the Table 2 scenes is 0.4 s, about what a stale LU costs in GMRES
 /// iterations) and the Hertz start.
 ///
+/// Where GMRES corrects the LU anyway (`reuse_lu`), the LU is MUMPS's block low-rank one
+/// ([`BLR_DROPPING`]); a back-substitution alone (`preonly`) keeps the full-rank LU.
+///
 /// Set with `set_ours` before every solve, so that each solve of a process gets its own,
 /// while the user's flags stay.
 pub fn set_newton_linear_solver(reuse_lu: bool) -> petsc::Result<()> {
     use petsc::options::set_ours;
     let settings: &[(&str, &str)] = if reuse_lu {
-        &[("-ksp_type", "gmres"), ("-ksp_gmres_restart", "100"), ("-snes_lag_preconditioner", "3"), ("-snes_ksp_ew", "true")]
+        &[
+            ("-ksp_type", "gmres"),
+            ("-ksp_gmres_restart", "100"),
+            ("-snes_lag_preconditioner", "3"),
+            ("-snes_ksp_ew", "true"),
+            ("-mat_mumps_icntl_35", "1"),
+            ("-mat_mumps_cntl_7", BLR_DROPPING),
+        ]
     } else {
-        &[("-ksp_type", "preonly"), ("-snes_lag_preconditioner", "1"), ("-snes_ksp_ew", "false")]
+        &[("-ksp_type", "preonly"), ("-snes_lag_preconditioner", "1"), ("-snes_ksp_ew", "false"), ("-mat_mumps_icntl_35", "0")]
     };
     for (k, v) in settings {
         set_ours(k, v)?;
