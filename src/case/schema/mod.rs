@@ -228,7 +228,7 @@ pub struct Accuracy {
     /// zone instead.
     pub marking: f64,
     /// Most unknowns a level may have: a level that would exceed it is not solved, and the
-    /// last level's result is written with its estimated error (exit 4); default 600,000.
+    /// last level's result is written with its estimated error (exit 4); default 800,000.
     pub max_unknowns: u64,
     /// Wall-time budget of the refinement levels after the first, in seconds from the start
     /// of the run: a level still running when it is spent is abandoned and the last
@@ -243,9 +243,11 @@ pub struct Accuracy {
 /// the films of the whole-zone refinement with a third of the unknowns.
 pub const DEFAULT_MARKING: f64 = 0.9;
 
-/// Default of `accuracy.max_unknowns`: about 6.5 GB per rank on 2 ranks with MUMPS (the
-/// peak of a level grows like its unknowns to the power 1.2-1.4).
-pub const DEFAULT_MAX_UNKNOWNS: u64 = 600_000;
+/// Default of `accuracy.max_unknowns`: about 6.5 GB per rank on 2 ranks with MUMPS's block
+/// low-rank LU (the peak of a level grows like its unknowns to the power 1.2-1.4).
+/// cases/hard/heavy-2gpa's level 5 (789,564 unknowns) peaked at 6.7 GB per rank and took its
+/// hm estimate from 1.35 % to 0.17 %; with the full-rank LU the same memory held 600,000.
+pub const DEFAULT_MAX_UNKNOWNS: u64 = 800_000;
 
 /// Default of `accuracy.max_seconds`: one hour, about 2.5 times the slowest Moes point that
 /// reaches 0.01 on 2 ranks when the machine is idle (M = 1000, L = 20: 1,361 s) and three
@@ -343,8 +345,8 @@ pub const ACCURACY_FIELDS: &[Field] = &[
         "most unknowns (elastic + pressure + h0) a refinement level may have",
         "",
         Kind::Number(Range::Closed(1e4, 1e9)),
-        Presence::Default("600000"),
-        note = "a level that would exceed it refines only the marked triangles of largest indicator that fit, once per run, when even the next full level's change could take every estimate below the target; otherwise, or when those carry less than a quarter of the marked indicator, it is not solved: the last level's result is written with its estimated error, summary.json says accuracy.reached = false, and the exit code is 4 (6-7 GB per rank on 2 ranks at 600,000; raise it on a larger machine)"
+        Presence::Default("800000"),
+        note = "a level that would exceed it refines only the marked triangles of largest indicator that fit, once per run, when even the next full level's change could take every estimate below the target; otherwise, or when those carry less than a quarter of the marked indicator, it is not solved: the last level's result is written with its estimated error, summary.json says accuracy.reached = false, and the exit code is 4 (6-7 GB per rank on 2 ranks at 800,000; raise it on a larger machine)"
     ),
     f!(
         "max_seconds",
