@@ -222,8 +222,8 @@ fn physics_helpers() {
     assert!((hd * 1e6 - 0.52).abs() < 0.01);
     assert!(rel(s.moes().unwrap().w, 1.015625e-6) < 1e-6);
     // NVM is a fit for Barus, incompressible lubricants only; here (M, L) = (366.0, 7.459)
-    // and its H = 3.5881, so hc = H R sqrt(2U) = 0.56687 um (computed by hand from the
-    // groups of the scene).
+    // and its H = 3.5881, so hc = H R sqrt(2U) = 0.56687 um (computed apart from this code,
+    // from the scene's data and the published formula).
     assert!(s.nijenbanning_hc().is_none());
     let b = parse_scene(
         &paper_with("viscosity = \"roelands\"", "viscosity = \"barus\"")
