@@ -12,6 +12,7 @@ use crate::error::{Error, ResultExt};
 use crate::friction::pass::{friction_pass, stress_at, FaceSolution, FrictionResult, FrictionSetup};
 use crate::friction::shear::ShearLaw;
 use crate::mesh::{self, Mesh};
+use crate::physics::HamrockDowson;
 use crate::solid::dofmap::DofMap;
 use serde_json::json;
 use std::path::Path;
@@ -244,7 +245,9 @@ pub fn post_point(
         st.pmax * ph,
         load_error
     ));
-    if let Some(line) = formulas_line(scene, st.hc * hs, st.hm * hs) {
+    // The film formulas, for the log line here and summary.json below.
+    let (hd, nvm) = (scene.hamrock_dowson(), scene.nijenbanning_hc());
+    if let Some(line) = formulas_line(hd.as_ref(), nvm, st.hc * hs, st.hm * hs) {
         ctx.log(line);
     }
     let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
@@ -350,7 +353,6 @@ pub fn post_point(
     let face_p = dir.join(super::restart::FACE_PRESSURE);
     crate::output::write_atomic(&face_p, super::restart::face_pressure_csv(mesh, &|n| fields.p_node(n), a, ph).as_bytes())
         .map_err(Error::writing(&face_p))?;
-    let hd = scene.hamrock_dowson();
     let (n_u, n_p) = layout.counts();
     let kin = scene.kinematics().expect("lubricated scene");
     use crate::output::summary::*;
@@ -391,7 +393,7 @@ pub fn post_point(
             h0_m: st.h0 * hs,
             hc_hamrock_dowson_m: hd.map(|h| h.central_film_thickness()),
             hm_hamrock_dowson_m: hd.map(|h| h.minimum_film_thickness()),
-            hc_nijenbanning_m: scene.nijenbanning_hc(),
+            hc_nijenbanning_m: nvm,
         },
         pressure: PressureSummary {
             pmax_pa: st.pmax * ph,
@@ -576,16 +578,17 @@ impl FaceSolution for crate::ehl::post::FieldsOnFace<'_> {
     }
 }
 
-/// The film formulas beside the result, each with the result's difference from it: a user
-/// comparing with a formula sees the formula's own spread (docs/validation.md) named, not
-/// an error of this solution. None when the scene has no finite, positive formula film
-/// (rigid or isoviscous solids).
-fn formulas_line(scene: &Scene, hc: f64, hm: f64) -> Option<String> {
+/// The film formulas beside the result (Hamrock-Dowson's `hd`, the Nijenbanning-Venner-Moes
+/// central film `nvm`), each with the result's difference from it: a user comparing with a
+/// formula sees the formula's own spread (docs/validation.md) named, not an error of this
+/// solution. None when the scene has no finite, positive formula film (rigid or isoviscous
+/// solids).
+fn formulas_line(hd: Option<&HamrockDowson>, nvm: Option<f64>, hc: f64, hm: f64) -> Option<String> {
     let ok = |v: f64| v.is_finite() && v > 0.0;
-    let hd = scene.hamrock_dowson().filter(|h| ok(h.central_film_thickness()) && ok(h.minimum_film_thickness()))?;
+    let hd = hd.filter(|h| ok(h.central_film_thickness()) && ok(h.minimum_film_thickness()))?;
     let d = |x: f64, f: f64| 100.0 * (x / f - 1.0);
     let (c, m) = (hd.central_film_thickness(), hd.minimum_film_thickness());
-    let nvm = scene.nijenbanning_hc().map_or(String::new(), |n| format!("; Nijenbanning-Venner-Moes hc {n:.4e} m ({:+.1} %)", d(hc, n)));
+    let nvm = nvm.map_or(String::new(), |n| format!("; Nijenbanning-Venner-Moes hc {n:.4e} m ({:+.1} %)", d(hc, n)));
     Some(format!(
         "film formulas (curve fits of a few to tens of per cent, not checks; the result's difference in brackets): Hamrock-Dowson hc {c:.4e} m ({:+.1} %), hm {m:.4e} m ({:+.1} %){nvm}",
         d(hc, c),

@@ -1,5 +1,6 @@
-//! Film-thickness regression formulas for point contacts (Hamrock-Dowson, Nijenbanning-Venner-Moes), used as references for the
-//! full-system solution (paper Table 2 compares with Hamrock-Dowson).
+//! Film-thickness regression formulas for point contacts (Hamrock-Dowson,
+//! Nijenbanning-Venner-Moes), used as references for the full-system solution (paper
+//! Table 2 compares with Hamrock-Dowson).
 //!
 //! Conventions (Hamrock & Dowson 1977, "Isothermal elastohydrodynamic lubrication of point
 //! contacts, Part III - Fully flooded results", J. Lubr. Technol. 99(2), 264-276):

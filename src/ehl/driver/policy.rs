@@ -233,10 +233,11 @@ pub fn set_newton_defaults(target: f64) -> petsc::Result<()> {
 /// GMRES is preconditioned with. The low-rank blocks of the fronts are compressed to this
 /// relative accuracy: the factorisation is cheaper and smaller, and GMRES, which corrects a
 /// three-step-old LU anyway, takes the same Newton steps or one more per level. table2-ue2
-/// at target 0.005 (2 ranks, the same films and estimates to 6 digits): 148 s and 4.3 GB per rank against
-/// 187 s and 5.3 GB with the full-rank LU (medians of 3). Single runs of other values: 1e-6
-/// 164 s (1e-5: 138 s); 1e-4 142 s, 3.8 GB, one Newton step more on level 3; 1e-3 146 s,
-/// two more on level 4. docs/performance.md, "Block low-rank LU under GMRES".
+/// at target 0.005 (2 ranks, the same films and estimates to 6 digits): 148 s and 4.3 GB
+/// per rank against 187 s and 5.3 GB with the full-rank LU (medians of 3). Single runs of
+/// other values: 1e-6 164 s (1e-5: 138 s); 1e-4 142 s, 3.8 GB, one Newton step more on
+/// level 3; 1e-3 146 s, two more on level 4. docs/performance.md, "Block low-rank LU under
+/// GMRES".
 pub const BLR_DROPPING: &str = "1e-5";
 
 /// The linear solve of a Newton step (each overridable by PETSc options).
