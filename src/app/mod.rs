@@ -84,7 +84,12 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
                 std::thread::sleep(std::time::Duration::from_secs(2));
             }
             let who = if rank == 0 { String::new() } else { format!(" (rank {rank})") };
-            eprintln!("ehl-petsc: error{who}: PETSc could not start with the given PETSc options or PETSC_OPTIONS (PETSc error code {}; PETSc's own message is above); all ranks are stopped", e.code);
+            // PETSc prints its own message from every rank at the same moment, a line in
+            // several writes, so the ranks' lines interleave mid-line. One write (atomic on
+            // a pipe below PIPE_BUF) that starts with a newline keeps this line whole and at
+            // the start of a line whatever the other ranks are printing.
+            let line = format!("\nehl-petsc: error{who}: PETSc could not start with the given PETSc options or PETSC_OPTIONS (PETSc error code {}; PETSc's own message is above); all ranks are stopped\n", e.code);
+            let _ = std::io::Write::write_all(&mut std::io::stderr().lock(), line.as_bytes());
             // SAFETY: plain MPI_Abort on the world communicator; it does not return.
             unsafe { mpi::ffi::MPI_Abort(mpi::ffi::RSMPI_COMM_WORLD, 3) };
             return 3;
