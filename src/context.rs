@@ -97,27 +97,14 @@ impl Context {
     }
 }
 
-/// Keys of summary.json that may be null (absent optional values, such as the mesh quality
-/// of rigid solids, which have no 3D mesh), not non-finite numbers.
-const MAY_BE_NULL: &[&str] = &[
-    "worst_quality",
-    "spin_centre_z_m",
-    "hc_hamrock_dowson_m",
-    "hm_hamrock_dowson_m",
-    "hc_nijenbanning_m",
-    "moes",
-    "entrainment_speed_m_s",
-    "snes_reason",
-    "path",
-];
-
-/// The dotted paths of the nulls in `v` outside [`MAY_BE_NULL`] and the scene.
+/// The dotted paths of the nulls in `v` outside [`crate::output::summary::MAY_BE_NULL`] and
+/// the scene.
 fn null_numbers(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
     match v {
         serde_json::Value::Null => out.push(path.to_string()),
         serde_json::Value::Object(m) => {
             for (k, x) in m {
-                if path.is_empty() && k == "scene" || MAY_BE_NULL.contains(&k.as_str()) {
+                if path.is_empty() && k == "scene" || crate::output::summary::MAY_BE_NULL.contains(&k.as_str()) {
                     continue;
                 }
                 null_numbers(x, &if path.is_empty() { k.clone() } else { format!("{path}.{k}") }, out);

@@ -8,6 +8,21 @@ use crate::case::Scene;
 use crate::error::{Error, ResultExt};
 use serde::{Deserialize, Deserializer, Serialize};
 
+/// Keys of summary.json that may be null: absent optional values (the mesh quality of rigid
+/// solids, which have no 3D mesh; a film formula outside the setting it was fitted in), not
+/// non-finite numbers. The writer's check and the hard suite's both skip them.
+pub const MAY_BE_NULL: &[&str] = &[
+    "worst_quality",
+    "spin_centre_z_m",
+    "hc_hamrock_dowson_m",
+    "hm_hamrock_dowson_m",
+    "hc_nijenbanning_m",
+    "moes",
+    "entrainment_speed_m_s",
+    "snes_reason",
+    "path",
+];
+
 /// Reads null (a NaN or infinity when written) as NaN.
 fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
