@@ -223,6 +223,19 @@ fn cases(dir: &Path) -> Vec<Case> {
     let mut petsc_env = case("petsc-options-file-in-environment", &[&t2, "--set", "mesh.contact_size=1"], 3, &["PETSc could not start"]);
     petsc_env.env.push(("PETSC_OPTIONS", s("-options_file /nonexistent/opts")));
     v.push(petsc_env);
+    // The solver's own options are read after PETSc starts, on every rank alike.
+    v.push(case(
+        "ehl-option-not-a-number",
+        &[&t2, "--set", "mesh.contact_size=1", "-ehl_supg_delta", "abc"],
+        3,
+        &["-ehl_supg_delta", "a real number", "abc"],
+    ));
+    v.push(case(
+        "ehl-option-not-a-bool",
+        &[&t2, "--set", "mesh.contact_size=1", "-ehl_monitor", "maybe"],
+        3,
+        &["-ehl_monitor", "true or false", "maybe"],
+    ));
     v
 }
 

@@ -96,14 +96,18 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
         }
     };
     crate::interrupt::install();
-    match crate::ehl_options::read(crate::petsc::comm_world()) {
+    // Every rank reads the same options and fails alike: rank 0 reports it, once.
+    match collective::agree(&world, crate::ehl_options::read(crate::petsc::comm_world()).map_err(Error::from)) {
         Ok(o) => {
             if let Some(font) = &o.plot_font {
                 crate::output::plot::set_font_file(font);
             }
         }
         Err(e) => {
-            eprintln!("ehl-petsc: error: cannot read the -ehl_ options: {e}");
+            if rank == 0 {
+                eprintln!("ehl-petsc: error: cannot read the -ehl_ options: {e}");
+            }
+            drop(petsc);
             return 3;
         }
     }

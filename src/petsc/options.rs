@@ -74,6 +74,12 @@ pub struct Group {
     items: Box<super::ffi::PetscOptionItems>,
 }
 
+/// A PETSc error of reading option `name`, which takes `allowed`: named, so that the user
+/// sees which option and what it takes (PETSc's message has the value given).
+fn option_error(name: &str, allowed: &str, e: super::PetscError) -> super::PetscError {
+    super::PetscError { code: e.code, message: format!("{name} takes {allowed} ({})", e.message) }
+}
+
 impl Group {
     /// Starts a group titled `title` (the heading `-help` prints) in manual section `section`.
     pub fn begin(comm: super::ffi::MPI_Comm, title: &str, section: &str) -> Result<Group> {
@@ -97,7 +103,8 @@ impl Group {
             default as super::ffi::PetscBool,
             &mut v,
             std::ptr::null_mut()
-        ))?;
+        ))
+        .map_err(|e| option_error(name, "true or false", e))?;
         Ok(v != 0)
     }
 
@@ -105,7 +112,8 @@ impl Group {
     pub fn real(&mut self, name: &str, help: &str, default: f64) -> Result<Option<f64>> {
         let (n, h, m) = (cstr(name), cstr(help), cstr("EhlOptions"));
         let (mut v, mut set) = (default, 0 as super::ffi::PetscBool);
-        pcall!(super::ffi::PetscOptionsReal_Private(&mut *self.items, n.as_ptr(), h.as_ptr(), m.as_ptr(), default, &mut v, &mut set))?;
+        pcall!(super::ffi::PetscOptionsReal_Private(&mut *self.items, n.as_ptr(), h.as_ptr(), m.as_ptr(), default, &mut v, &mut set))
+            .map_err(|e| option_error(name, "a real number", e))?;
         Ok((set != 0).then_some(v))
     }
 
@@ -123,7 +131,8 @@ impl Group {
             &mut set,
             i32::MIN,
             i32::MAX
-        ))?;
+        ))
+        .map_err(|e| option_error(name, "an integer", e))?;
         Ok((set != 0).then_some(v))
     }
 
@@ -141,7 +150,8 @@ impl Group {
             buf.as_mut_ptr(),
             buf.len(),
             &mut set
-        ))?;
+        ))
+        .map_err(|e| option_error(name, "a string of at most 4095 bytes", e))?;
         Ok((set != 0).then(|| unsafe { std::ffi::CStr::from_ptr(buf.as_ptr()) }.to_string_lossy().into_owned()))
     }
 
