@@ -223,6 +223,17 @@ fn cases(dir: &Path) -> Vec<Case> {
     let mut petsc_env = case("petsc-options-file-in-environment", &[&t2, "--set", "mesh.contact_size=1"], 3, &["PETSc could not start"]);
     petsc_env.env.push(("PETSC_OPTIONS", s("-options_file /nonexistent/opts")));
     v.push(petsc_env);
+    // A PETSc option of the wrong type is read only when its solver is set up (here rank 0's
+    // condensation): no --check, which starts no PETSc.
+    let bad_value_out = dir.join("out-petsc-option-bad-value").display().to_string();
+    let mut bad_value = case(
+        "petsc-option-bad-value",
+        &[&t2, "--set", "mesh.contact_size=1", "-elastic_mat_mumps_icntl_14", "abc", "--output", &bad_value_out],
+        2,
+        &["'-elastic_mat_mumps_icntl_14 abc'", "Input string abc"],
+    );
+    bad_value.own_output = true;
+    v.push(bad_value);
     // The solver's own options are read after PETSc starts, on every rank alike.
     v.push(case(
         "ehl-option-not-a-number",

@@ -114,6 +114,37 @@ pub fn check_petsc_args(petsc: &[String]) -> Result<(), Error> {
     Ok(())
 }
 
+/// The user's PETSc options (`-name value` in `petsc`) whose value PETSc's error message
+/// `error` quotes as one it could not take: "Input string abc has no numeric value",
+/// "Unknown logical value: maybe", "Unable to find requested SNES type foo". PETSc reads
+/// an option only when the object it belongs to is set up, often minutes into a run, and
+/// its message does not name the option: this names it.
+pub fn options_quoted(petsc: &[String], error: &str) -> Vec<String> {
+    let after = |marker: &str| -> Vec<&str> {
+        error.match_indices(marker).filter_map(|(i, _)| error[i + marker.len()..].split_whitespace().next()).collect()
+    };
+    let mut quoted: Vec<&str> = after("Input string ");
+    quoted.extend(after("Unknown logical value: "));
+    for (i, _) in error.match_indices("Unable to find requested ") {
+        let rest = &error[i..];
+        let clause = rest.split(';').next().unwrap_or(rest);
+        if let Some(v) = clause.split(" type ").nth(1).and_then(|t| t.split_whitespace().next()) {
+            quoted.push(v);
+        }
+    }
+    let mut out = Vec::new();
+    for w in petsc.windows(2) {
+        let value = w[1].trim_end_matches([';', ',']);
+        if is_petsc_option(&w[0]) && quoted.iter().any(|q| q.trim_end_matches([';', ',']) == value) {
+            let o = format!("{} {}", w[0], w[1]);
+            if !out.contains(&o) {
+                out.push(o);
+            }
+        }
+    }
+    out
+}
+
 /// The rank of this process as the MPI launcher numbers it (0 when not launched by one),
 /// read before MPI is initialised so that a usage error is printed once, by rank 0.
 pub fn launcher_rank() -> usize {
@@ -123,6 +154,24 @@ pub fn launcher_rank() -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_petsc_value_petsc_rejected_is_named_with_its_option() {
+        let args = s(&["-snes_max_it", "abc", "-ksp_view", "-snes_type", "foo", "-pc_type", "lu"]);
+        // PETSc's messages as this PETSc (3.18) writes them.
+        let int = "PetscOptionsStringToInt (options.c:2176): Input string abc has no integer value (do not include . in it); PetscOptionsGetInt (options.c:2515): Argument out of range";
+        assert_eq!(options_quoted(&args, int), ["-snes_max_it abc"]);
+        let ty = "SNESSetType (snes.c:4792): Unable to find requested SNES type foo; SNESSetFromOptions (snes.c:951): Unknown type. Check for miss-spelling";
+        assert_eq!(options_quoted(&args, ty), ["-snes_type foo"]);
+        let b = s(&["-snes_converged_reason", "maybe"]);
+        assert_eq!(
+            options_quoted(&b, "PetscOptionsStringToBool (options.c:2147): Unknown logical value: maybe; PetscOptionsGetBool"),
+            ["-snes_converged_reason maybe"]
+        );
+        // A message that quotes no value, or a value no option has: nothing named.
+        assert!(options_quoted(&args, "MatLUFactorNumeric: Zero pivot in LU factorization").is_empty());
+        assert!(options_quoted(&args, "Input string xyz has no numeric value").is_empty());
+    }
 
     fn s(v: &[&str]) -> Vec<String> {
         v.iter().map(|x| x.to_string()).collect()

@@ -146,10 +146,25 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             // A failure every rank shares (Newton, an interruption) is printed once, by
             // rank 0; a rank that failed alone prints its own message.
             let all_failed = collective::all(&ctx.world, failed_here);
+            // A value of one of the user's PETSc options that PETSc rejected when it read it
+            // (a solver is set up only when it is first used): bad input, named.
+            let quoted = cli::options_quoted(&opts.petsc_args, &e.to_string());
+            // The rank that read the option may be alone with PETSc's message (rank 0's
+            // condensation): every rank ends with the same code.
+            let bad_option = !collective::all(&ctx.world, quoted.is_empty());
             if rank == 0 || (failed_here && !all_failed) {
-                eprintln!("ehl-petsc: error{}: {e}", if all_failed { String::new() } else { format!(" (rank {rank})") });
+                let who = if all_failed { String::new() } else { format!(" (rank {rank})") };
+                if quoted.is_empty() {
+                    eprintln!("ehl-petsc: error{who}: {e}");
+                } else {
+                    eprintln!(
+                        "ehl-petsc: error{who}: PETSc rejects the value of the PETSc option '{}' (PETSc's message follows): {e}",
+                        quoted.join("', '")
+                    );
+                }
             }
             match crate::interrupt::agreed() {
+                0 if bad_option => 2,
                 // A spent time budget that nothing turned into a labelled result.
                 0 | crate::interrupt::DEADLINE => 1,
                 sig => 128 + sig,

@@ -127,18 +127,20 @@ pub fn face_compliance(world: &SimpleCommunicator, mesh: &Mesh, nu: f64, tractio
     let dofs = DofMap::new(mesh, &part, 1);
     let mut s = vec![0.0; nr * nr];
     let mut status: i32 = 0;
+    let mut failure = None;
     if world.rank() == 0 {
         match schur_complement(mesh, &part, &dofs, nu, &rows) {
             Ok(v) => s = v,
             Err(e) => {
                 status = 1;
-                eprintln!("ehl-petsc: face condensation failed on rank 0: {e}");
+                failure = Some(e);
             }
         }
     }
     world.process_at_rank(0).broadcast_into(&mut status);
     if status != 0 {
-        return Err(rust_error("static condensation of the elastic block failed on rank 0 (see its message)"));
+        // Every rank fails; rank 0 keeps PETSc's message, which the program prints once.
+        return Err(failure.unwrap_or_else(|| rust_error("static condensation of the elastic block failed on rank 0")));
     }
     world.process_at_rank(0).broadcast_into(&mut s[..]);
     let dbg = crate::ehl_options::get().monitor;
