@@ -85,8 +85,7 @@ impl Context {
         let path = dir.join("summary.json");
         // serde_json writes a NaN or an infinity as null: a result with such a number is
         // never written, let alone marked converged.
-        let mut bad = Vec::new();
-        null_numbers(summary, "", &mut bad);
+        let bad = crate::output::summary::null_paths(summary);
         if !bad.is_empty() {
             return Err(Error::numerical(format!("the result holds numbers that are not finite ({}); no result written", bad.join(", "))));
         }
@@ -94,27 +93,5 @@ impl Context {
         crate::output::write_atomic(&path, text.as_bytes()).map_err(Error::writing(&path))?;
         self.log(format!("wrote {}", path.display()));
         Ok(())
-    }
-}
-
-/// The dotted paths of the nulls in `v` outside [`crate::output::summary::MAY_BE_NULL`] and
-/// the scene.
-fn null_numbers(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
-    match v {
-        serde_json::Value::Null => out.push(path.to_string()),
-        serde_json::Value::Object(m) => {
-            for (k, x) in m {
-                if path.is_empty() && k == "scene" || crate::output::summary::MAY_BE_NULL.contains(&k.as_str()) {
-                    continue;
-                }
-                null_numbers(x, &if path.is_empty() { k.clone() } else { format!("{path}.{k}") }, out);
-            }
-        }
-        serde_json::Value::Array(a) => {
-            for (i, x) in a.iter().enumerate() {
-                null_numbers(x, &format!("{path}[{i}]"), out);
-            }
-        }
-        _ => {}
     }
 }

@@ -120,8 +120,13 @@ pub fn check_petsc_args(petsc: &[String]) -> Result<(), Error> {
 /// an option only when the object it belongs to is set up, often minutes into a run, and
 /// its message does not name the option: this names it.
 pub fn options_quoted(petsc: &[String], error: &str) -> Vec<String> {
+    // The word after `marker`, without the ';' that joins PETSc's messages.
     let after = |marker: &str| -> Vec<&str> {
-        error.match_indices(marker).filter_map(|(i, _)| error[i + marker.len()..].split_whitespace().next()).collect()
+        error
+            .match_indices(marker)
+            .filter_map(|(i, _)| error[i + marker.len()..].split_whitespace().next())
+            .map(|w| w.trim_end_matches([';', ',']))
+            .collect()
     };
     let mut quoted: Vec<&str> = after("Input string ");
     quoted.extend(after("Unknown logical value: "));
@@ -134,8 +139,7 @@ pub fn options_quoted(petsc: &[String], error: &str) -> Vec<String> {
     }
     let mut out = Vec::new();
     for w in petsc.windows(2) {
-        let value = w[1].trim_end_matches([';', ',']);
-        if is_petsc_option(&w[0]) && quoted.iter().any(|q| q.trim_end_matches([';', ',']) == value) {
+        if is_petsc_option(&w[0]) && quoted.contains(&w[1].as_str()) {
             let o = format!("{} {}", w[0], w[1]);
             if !out.contains(&o) {
                 out.push(o);

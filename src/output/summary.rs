@@ -10,7 +10,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 /// Keys of summary.json that may be null: absent optional values (the mesh quality of rigid
 /// solids, which have no 3D mesh; a film formula outside the setting it was fitted in), not
-/// non-finite numbers. The writer's check and the hard suite's both skip them.
+/// non-finite numbers ([`null_paths`] skips them).
 pub const MAY_BE_NULL: &[&str] = &[
     "worst_quality",
     "spin_centre_z_m",
@@ -22,6 +22,34 @@ pub const MAY_BE_NULL: &[&str] = &[
     "snes_reason",
     "path",
 ];
+
+/// The dotted paths (`film.hc_m`, `solver.path[2]`) of the nulls in a summary `v`: its
+/// non-finite numbers, apart from [`MAY_BE_NULL`] and everything below those keys, and the
+/// scene echo. The writer refuses a summary with any; the hard suite reports them.
+pub fn null_paths(v: &serde_json::Value) -> Vec<String> {
+    fn walk(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
+        match v {
+            serde_json::Value::Null => out.push(path.to_string()),
+            serde_json::Value::Object(m) => {
+                for (k, x) in m {
+                    if path.is_empty() && k == "scene" || MAY_BE_NULL.contains(&k.as_str()) {
+                        continue;
+                    }
+                    walk(x, &if path.is_empty() { k.clone() } else { format!("{path}.{k}") }, out);
+                }
+            }
+            serde_json::Value::Array(a) => {
+                for (i, x) in a.iter().enumerate() {
+                    walk(x, &format!("{path}[{i}]"), out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    walk(v, "", &mut out);
+    out
+}
 
 /// Reads null (a NaN or infinity when written) as NaN.
 fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {

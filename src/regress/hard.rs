@@ -5,7 +5,7 @@
 //! move less than the target between them (the error of the run at the target, measured
 //! against a run four times more accurate). A mesh pair (`ci/hard -m plain`) may move hc
 //! and hm by less than 2 %.
-use super::{flatten, Leaf};
+
 use serde_json::Value;
 
 /// Most negative nodal pressure allowed, in units of p_H.
@@ -54,17 +54,12 @@ fn key_numbers(s: &Value) -> Option<Key> {
     })
 }
 
-/// Result leaves that are null (NaN or infinite when written), apart from the values that
-/// may be absent ([`crate::output::summary::MAY_BE_NULL`], and everything below them).
+/// Result values that are null (NaN or infinite when written; values that may be absent
+/// excepted: [`crate::output::summary::null_paths`]).
 fn nan_keys(s: &Value) -> Vec<String> {
-    flatten(s)
+    crate::output::summary::null_paths(s)
         .into_iter()
-        .filter(|(k, v)| {
-            *v == Leaf::Null
-                && ["film.", "pressure.", "friction.", "solver."].iter().any(|p| k.starts_with(p))
-                && !k.split('.').any(|part| crate::output::summary::MAY_BE_NULL.contains(&part.split('[').next().unwrap_or(part)))
-        })
-        .map(|(k, _)| k)
+        .filter(|k| ["film.", "pressure.", "friction.", "solver."].iter().any(|p| k.starts_with(p)))
         .collect()
 }
 
