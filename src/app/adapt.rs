@@ -28,7 +28,10 @@
 use super::estimate::Estimate;
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, Setup};
-use super::marking::{cut_count, goal_mark, goals, longest_edges, next_field, zone_mark, Marking, TimeLeft, MIN_BUDGET_SHARE};
+use super::marking::{
+    cut_count, field_of_sizes, goal_mark, goals, longest_edges, next_field, zone_mark, Marking, TimeLeft, MIN_BUDGET_SHARE,
+    QUARTER_ESTIMATE,
+};
 use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
 use crate::case::Scene;
@@ -76,6 +79,10 @@ pub struct Level {
     pub est: Option<Estimate>,
     /// How the level was cut to a budget (None: it refined all its marked triangles).
     pub cut: Option<Cut>,
+    /// How many halvings of the level before its finest refinement made: 2 where that
+    /// level's marking quartered triangles ([`super::marking::QUARTER_RATIO`]), else 1. The
+    /// estimate's crossing guard allows a change to contract by that many steps.
+    pub halvings: u32,
 }
 
 /// A level cut to a budget: it refined the `count` marked triangles of largest indicator,
@@ -138,6 +145,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     ));
     let mut levels: Vec<Level> = Vec::new();
     let mut field: Option<Arc<SizeField>> = None;
+    // How many halvings the finest refinement of `field` makes: 2 where its marking
+    // quartered triangles ([`Level::halvings`]).
+    let mut halvings = 1;
     let mut previous: Option<Solved> = None;
     let growth = scene.mesh.growth;
     // Tries of the first level on a finer mesh after it failed on the scene's own.
@@ -203,7 +213,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         "accuracy: {over_what}; it refines the {count} of the {marked} marked triangles with the largest indicator instead ({:.0} % of their indicator)",
                         100.0 * share
                     ));
-                    field = Some(Arc::new(next_field(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), &m.largest(count), growth)));
+                    field =
+                        Some(Arc::new(field_of_sizes(&prev.setup.mesh, &m.sizes(&longest_edges(&prev.setup.mesh), Some(count)), growth)));
+                    // The quartered triangles are the largest: any cut keeps some.
+                    halvings = if m.quartered() > 0 { 2 } else { 1 };
                     cut = Some(Cut { count, share, by: if by_time.is_some() { Budget::Seconds } else { Budget::Unknowns } });
                     continue;
                 }
@@ -340,6 +353,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         let edges = longest_edges(&prev.setup.mesh);
                         let marked = zone_mark(&pf, &edges);
                         field = Some(Arc::new(next_field(&prev.setup.mesh, &edges, &marked, growth)));
+                        halvings = 1;
                         zone_retry = None;
                         tried_s += t0.elapsed().as_secs_f64();
                         continue;
@@ -438,6 +452,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             friction: friction.as_ref().map(|f| [f.fx, f.fz]),
             est: None,
             cut: cut.take(),
+            halvings: if k == 0 { 1 } else { halvings },
         };
         over.clear();
         levels.push(level);
@@ -484,13 +499,15 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             _ => None,
         };
         let exponents = exponents.map(|got| super::sensitivity::report(ctx, got));
+        // Quartering pays only with more than one level of halving still ahead.
+        let quarter = est.is_some_and(|e| e.values().iter().any(|&v| v > QUARTER_ESTIMATE * target));
         let marked = if !last {
             Some(match adjoint.as_ref().filter(|_| goal) {
                 // A failed adjoint costs this level's goal-oriented marking, not the run (an
                 // interruption is acted on at the check after the marking).
                 Some(Ok(a)) => {
                     match collective::agree(&ctx.world, goals(ctx, scene, a, &fields, &st, friction.as_ref()))
-                        .map(|goals| goal_mark(ctx, scene, &fields, &goals, &edges, acc.marking))
+                        .map(|goals| goal_mark(ctx, scene, &fields, &goals, &edges, acc.marking, quarter))
                     {
                         Ok(m) => {
                             zone_retry = Some(k + 1);
@@ -540,12 +557,13 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             };
             return finish(ctx, scene, &here, target, &levels, Some(short_of(target, &why, k, est)));
         }
-        let marked = &here.marking.as_ref().expect("marked when the loop goes on").marked;
-        if !marked.iter().any(|&m| m) {
+        let marking = here.marking.as_ref().expect("marked when the loop goes on");
+        if !marking.marked.iter().any(|&m| m) {
             let why = short_of(target, &format!("every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"), k, est);
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
-        field = Some(Arc::new(next_field(&here.setup.mesh, &edges, marked, growth)));
+        field = Some(Arc::new(field_of_sizes(&here.setup.mesh, &marking.sizes(&edges, None), growth)));
+        halvings = if marking.quartered() > 0 { 2 } else { 1 };
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
             return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
         }
@@ -656,13 +674,13 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
     let mut report = json!({
         "target": target,
         "reached": shortfall.is_none(),
-        "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it), and at least 1/8 of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change",
+        "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change",
         "levels": levels.iter().enumerate().map(|(k, l)| {
             let mut v = json!({
                 "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
                 "contact_triangles": l.contact_triangles, "smallest_size_a": l.min_size,
                 "newton_iterations": l.newton_iterations, "seconds": l.seconds, "failed_attempts_seconds": l.failed_seconds,
-                "hc_m": l.hc, "hm_m": l.hm, "hm_at_a": l.hm_at, "pmax_pa": l.pmax,
+                "halvings": l.halvings, "hc_m": l.hc, "hm_m": l.hm, "hm_at_a": l.hm_at, "pmax_pa": l.pmax,
             });
             // The first level has no estimate: the key is left out (summary.json holds no null).
             if let Some(e) = l.est {

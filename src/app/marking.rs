@@ -216,7 +216,15 @@ pub(super) fn goals(
 /// triangle's edges: the part of the adjoint the triangle's P1 interpolant misses),
 /// relative to that value, summed over the goals ([`goals`]), plus the gradient-jump
 /// term's share of each value's error ([`triangle_shares`]); Doerfler marking at `theta`.
-pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goals: &[Goal], edges: &[f64], theta: f64) -> Marking {
+pub(super) fn goal_mark(
+    ctx: &Context,
+    scene: &Scene,
+    fields: &FieldsOnFace,
+    goals: &[Goal],
+    edges: &[f64],
+    theta: f64,
+    quarter: bool,
+) -> Marking {
     let t0 = Instant::now();
     let mesh = fields.mesh;
     let rho = indicators(scene, fields);
@@ -250,16 +258,18 @@ pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goa
     let marked = dorfler_mark(&eta, &eligible(edges), theta);
     let mut ranked: Vec<(usize, f64)> = (0..n).filter(|&t| marked[t]).map(|t| (t, eta[t])).collect();
     ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let marking = Marking { marked, ranked: Some(ranked), quarter };
     let places = goals.iter().filter(|g| g.name == "hm").count();
     // The hm places are consecutive goals: one name.
     let mut names: Vec<&str> = goals.iter().map(|g| g.name).collect();
     names.dedup();
     ctx.log(format!(
-        "accuracy: goal-oriented marking ({}{}): {} of {} contact triangles marked (fraction {theta} of the weighted indicator{}), {:.1} s",
+        "accuracy: goal-oriented marking ({}{}): {} of {} contact triangles marked ({} of them quartered; fraction {theta} of the weighted indicator{}), {:.1} s",
         names.join(", "),
         if places > 1 { format!("; hm at {places} places") } else { String::new() },
-        marked.iter().filter(|&&m| m).count(),
-        marked.len(),
+        marking.marked.iter().filter(|&&m| m).count(),
+        marking.marked.len(),
+        marking.quartered(),
         if jumps.is_empty() {
             String::new()
         } else {
@@ -267,36 +277,80 @@ pub(super) fn goal_mark(ctx: &Context, scene: &Scene, fields: &FieldsOnFace, goa
         },
         t0.elapsed().as_secs_f64()
     ));
-    Marking { marked, ranked: Some(ranked) }
+    marking
 }
+
+/// A marked triangle whose indicator is at least this many times the smallest marked one is
+/// quartered instead of halved. A halved triangle's four children each keep at least 1/16
+/// of its indicator where the fields are no better than Lipschitz (the slowest an indicator
+/// of P2 fields falls: 1/4 from the area, 1/2 from the residual's density, 1/2 from the
+/// adjoint's surplus), so its children would still be marked at the next level; quartering
+/// now saves that level. On table2-ue2 the 0.0625 a level quarters 4 of its 115 marked
+/// triangles, the notch of the side lobe where hm sits, and the next level's hm error falls
+/// from -0.73 % to +0.25 % for 5 % more unknowns (docs/accuracy.md, "Quartering where
+/// halving is not enough").
+pub const QUARTER_RATIO: f64 = 16.0;
+
+/// A level quarters only when one of its estimated errors exceeds this many times the
+/// target: quartering saves a level only when more than one level of halving is still
+/// ahead, and one halving takes an error down by about 4 (second order, as hc and hm
+/// converge on the adaptive levels). Without the guard, M = 20, L = 10 at target 0.01
+/// quartered its 0.0625 a level, whose estimates (0.88 %, 0.01 %) were already below the
+/// target, into a 0.0156 a level that needs the raised gradient-jump factor: 229 s against
+/// 28 s for the same films. Level 0 has no estimate and halves.
+pub const QUARTER_ESTIMATE: f64 = 4.0;
 
 /// The triangles a level marks for the next one, and, when the marking ranks them
 /// (goal-oriented), the marked ones by decreasing indicator with their indicator: the next
-/// level can then be cut to its budget ([`cut_count`]).
+/// level can then be cut to its budget ([`cut_count`]), and the marked triangles of
+/// largest indicator are quartered ([`QUARTER_RATIO`]).
 pub(super) struct Marking {
     pub marked: Vec<bool>,
     pub ranked: Option<Vec<(usize, f64)>>,
+    /// Whether the triangles of largest indicator are quartered ([`QUARTER_ESTIMATE`]).
+    pub quarter: bool,
 }
 
 impl Marking {
     /// A marking with no ranking (zone marking).
     pub fn unranked(marked: Vec<bool>) -> Marking {
-        Marking { marked, ranked: None }
+        Marking { marked, ranked: None, quarter: false }
     }
 
-    /// The `count` marked triangles of largest indicator, as flags (all of them without a
-    /// ranking).
-    pub fn largest(&self, count: usize) -> Vec<bool> {
+    /// The marked triangles the next level quarters (their count).
+    pub fn quartered(&self) -> usize {
+        match &self.ranked {
+            Some(r) if self.quarter => {
+                let least = r.last().map_or(0.0, |v| v.1);
+                r.iter().filter(|v| v.1 >= QUARTER_RATIO * least).count()
+            }
+            _ => 0,
+        }
+    }
+
+    /// Each contact triangle's size at the next level (units of a; `edges`:
+    /// [`longest_edges`]) when the `count` marked triangles of largest indicator are refined
+    /// (all of them with `None` or without a ranking): marked triangles at half their size,
+    /// or a quarter when the marking quarters ([`QUARTER_RATIO`], against the whole
+    /// marking's smallest indicator), the others at theirs.
+    pub fn sizes(&self, edges: &[f64], count: Option<usize>) -> Vec<f64> {
+        let mut sizes = edges.to_vec();
         match &self.ranked {
             Some(r) => {
-                let mut m = vec![false; self.marked.len()];
-                for &(t, _) in r.iter().take(count) {
-                    m[t] = true;
+                let least = r.last().map_or(0.0, |v| v.1);
+                for &(t, eta) in r.iter().take(count.unwrap_or(r.len())) {
+                    sizes[t] *= if self.quarter && eta >= QUARTER_RATIO * least { 0.25 } else { 0.5 };
                 }
-                m
             }
-            None => self.marked.clone(),
+            None => {
+                for (s, &m) in sizes.iter_mut().zip(&self.marked) {
+                    if m {
+                        *s *= 0.5;
+                    }
+                }
+            }
         }
+        sizes
     }
 
     /// The share of the marked triangles' indicator that the `count` largest carry (1
@@ -476,9 +530,26 @@ mod tests {
         assert_eq!(cut_count(400_000, &[], 600_000), 0);
         // The largest of the ranked: the first of the ranking, whatever their index, and
         // the share of the indicator they carry.
-        let m = Marking { marked: vec![true, false, true, true], ranked: Some(vec![(3, 5.0), (0, 3.0), (2, 2.0)]) };
-        assert_eq!(m.largest(2), vec![true, false, false, true]);
+        let m = Marking { marked: vec![true, false, true, true], ranked: Some(vec![(3, 5.0), (0, 3.0), (2, 2.0)]), quarter: true };
+        assert_eq!(m.sizes(&[1.0; 4], Some(2)), vec![0.5, 1.0, 1.0, 0.5]);
         assert!((m.indicator_share(2) - 0.8).abs() < 1e-12);
-        assert_eq!(Marking::unranked(vec![true, false]).largest(0), vec![true, false]);
+        assert_eq!(Marking::unranked(vec![true, false]).sizes(&[1.0, 1.0], Some(0)), vec![0.5, 1.0]);
+    }
+
+    #[test]
+    fn a_marked_triangle_far_above_the_smallest_marked_indicator_is_quartered() {
+        // Indicators 40, 32, 3, 2: 32 is 16 times the smallest marked one, 3 is not.
+        let mut m = Marking { marked: vec![true; 4], ranked: Some(vec![(1, 40.0), (0, 32.0), (3, 3.0), (2, 2.0)]), quarter: true };
+        assert_eq!(m.quartered(), 2);
+        assert_eq!(m.sizes(&[0.25; 4], None), vec![0.0625, 0.0625, 0.125, 0.125]);
+        // Cut to the largest one: the others keep their size; the threshold stays the whole
+        // marking's, so a cut level quarters what the full one would.
+        assert_eq!(m.sizes(&[0.25; 4], Some(1)), vec![0.25, 0.0625, 0.25, 0.25]);
+        // A level whose estimates are near the target halves every marked triangle.
+        m.quarter = false;
+        assert_eq!(m.quartered(), 0);
+        assert_eq!(m.sizes(&[0.25; 4], None), vec![0.125; 4]);
+        // Zone marking has no ranking: every marked triangle is halved.
+        assert_eq!(Marking::unranked(vec![true, false]).quartered(), 0);
     }
 }
