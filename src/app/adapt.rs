@@ -5,16 +5,19 @@
 //!    goal-oriented indicator: the mass-flux residual ([`crate::reynolds::estimate`])
 //!    weighted by the adjoints of hc, hm and, with friction, fx and fz (how much a flux
 //!    error in each triangle moves them); with `marking` 0, every
-//!    triangle of the pressurised zone (a nodal pressure above 0.01 p_H). Halve their size,
-//!    keep the others' (a graded size field on the face, [`crate::mesh::size_field`]), and
-//!    mesh the solid anew under it (conforming bisection).
+//!    triangle of the pressurised zone (a nodal pressure above 0.01 p_H). Halve their size
+//!    (quarter it for those whose indicator is 16 times the smallest marked one, while an
+//!    estimate is above 4 times the target: `marking::QUARTER_RATIO`), keep the others'
+//!    (a graded size field on the face, [`crate::mesh::size_field`]), and mesh the solid
+//!    anew under it (conforming bisection).
 //! 3. Solve from the previous level's pressure, interpolated (mesh sequencing), and after a
 //!    monolithic level from its displacement too.
 //! 4. Estimate the error of hc and hm (and fx, fz with friction) from the change between
 //!    the last two levels, e_k = |Q_k - Q_{k-1}| max(1, rho/(1 - rho)) with rho the observed
 //!    ratio of the last two changes (capped at 0.8): for a sequence converging by a factor
 //!    rho per level the remaining error is rho/(1 - rho) times the last change. A change
-//!    below 1/8 of the one before it is a crossing of the limit, not convergence (see
+//!    below 1/8 of the one before it (1/64 on a level made by quartering) is a crossing of
+//!    the limit, not convergence (see
 //!    `estimate::estimate_scaled`). Stop when every estimate is below the target (from level 2 on, so
 //!    that rho is measured).
 //! 5. A next level above `accuracy.max_unknowns` refines only the marked triangles of

@@ -3,7 +3,8 @@
 //! e_k = |Q_k - Q_{k-1}| max(1, rho/(1 - rho)) with rho the observed ratio of the last two
 //! changes (capped at 0.8): for a sequence converging by a factor rho per level the
 //! remaining error is rho/(1 - rho) times the last change. A change below 1/8 of the one
-//! before it is a crossing of the limit, not convergence ([`estimate_scaled`]). A level cut
+//! before it (1/64 on a level made by quartering) is a crossing of the limit, not
+//! convergence ([`estimate_scaled`]). A level cut
 //! to the unknowns budget carries the estimate before it over ([`estimate_after_cut`]).
 use super::adapt::Level;
 use serde_json::json;

@@ -3,7 +3,9 @@
 //!
 //! - Goal-oriented marking (`accuracy.marking` = theta > 0): the mass-flux residual of
 //!   each triangle weighted by how much it moves the target values (their adjoints), the
-//!   fewest triangles carrying the fraction theta of the total (Doerfler).
+//!   fewest triangles carrying the fraction theta of the total (Doerfler); those far above
+//!   the smallest marked indicator are quartered while the target is far ([`QUARTER_RATIO`],
+//!   [`QUARTER_ESTIMATE`]).
 //! - Zone marking (`accuracy.marking = 0`): every triangle of the pressurised zone.
 use super::adapt::MIN_ADAPTIVE_SIZE;
 use super::Context;
