@@ -188,6 +188,21 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let time = time_left(ctx, acc, &levels, previous.as_ref());
         let by_time = time.filter(|t| t.unknowns() < acc.max_unknowns);
         let budget = by_time.map_or(acc.max_unknowns, |t| t.unknowns());
+        // Quartering saves a level; over a budget the level it would save is not reached
+        // anyway, and halving leaves room for the rest of the marking
+        // (cases/hard/spin-0.5deg: quartered, level 4 would have had 998,894 unknowns).
+        // The marking then halves, here and in a cut below.
+        if let Some(prev) = previous.as_mut().filter(|p| n > budget && p.marking.as_ref().is_some_and(|m| m.quartered() > 0)) {
+            let m = prev.marking.as_mut().expect("checked above");
+            ctx.log(format!(
+                "accuracy: level {k} would have {n} unknowns, above its budget of {budget}; again with its {} quartered triangles halved",
+                m.quartered()
+            ));
+            m.quarter = false;
+            field = Some(Arc::new(field_of_sizes(&prev.setup.mesh, &m.sizes(&longest_edges(&prev.setup.mesh), None), growth)));
+            halvings = 1;
+            continue;
+        }
         if let (Some(prev), true) = (&previous, n > budget) {
             // The level is cut to the budget: the marked triangles of largest indicator that
             // fit, once per run (a cut level is the last, below), and not when even the next
@@ -502,8 +517,12 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             _ => None,
         };
         let exponents = exponents.map(|got| super::sensitivity::report(ctx, got));
-        // Quartering pays only with more than one level of halving still ahead.
-        let quarter = est.is_some_and(|e| e.values().iter().any(|&v| v > QUARTER_ESTIMATE * target));
+        // Quartering pays only with more than one level of halving still ahead, and not
+        // while fz is a target (friction on a full domain: spin), whose error is spread
+        // and falls at first order (docs/accuracy.md, "Quartering where halving is not
+        // enough": spin-0.5deg).
+        let fz_target = friction.is_some() && !setup.half;
+        let quarter = !fz_target && est.is_some_and(|e| e.values().iter().any(|&v| v > QUARTER_ESTIMATE * target));
         let marked = if !last {
             Some(match adjoint.as_ref().filter(|_| goal) {
                 // A failed adjoint costs this level's goal-oriented marking, not the run (an
