@@ -233,8 +233,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     ));
                     field =
                         Some(Arc::new(field_of_sizes(&prev.setup.mesh, &m.sizes(&longest_edges(&prev.setup.mesh), Some(count)), growth)));
-                    // The quartered triangles are the largest: any cut keeps some.
-                    halvings = if m.quartered() > 0 { 2 } else { 1 };
+                    halvings = m.halvings();
                     cut = Some(Cut { count, share, by: if by_time.is_some() { Budget::Seconds } else { Budget::Unknowns } });
                     continue;
                 }
@@ -585,7 +584,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
         field = Some(Arc::new(field_of_sizes(&here.setup.mesh, &marking.sizes(&edges, None), growth)));
-        halvings = if marking.quartered() > 0 { 2 } else { 1 };
+        halvings = marking.halvings();
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
             return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
         }

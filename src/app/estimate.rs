@@ -42,7 +42,7 @@ impl Estimate {
         // is not one of a sequence, so the estimate before it is carried over instead. A cut
         // that kept nearly all of it is a level of the sequence ([`FULL_LEVEL_SHARE`]).
         let cut = levels.last().is_some_and(|l| l.cut.is_some_and(|c| c.share < FULL_LEVEL_SHARE));
-        let halvings: Vec<u32> = levels.iter().map(|l| l.halvings).collect();
+        let halvings = halvings(levels);
         let e = sequences(levels)
             .iter()
             .map(|(q, scale)| if cut { estimate_after_cut(q, &halvings, *scale) } else { estimate_scaled(q, &halvings, *scale) })
@@ -54,7 +54,7 @@ impl Estimate {
     /// estimate below `target` ([`least_after_cut`]): when not, it is not solved (on
     /// cases/hard/spin-0.33deg it cost 800 s and moved fx's estimate from 1.31 % to 1.29 %).
     pub(super) fn cut_could_reach(levels: &[Level], target: f64) -> bool {
-        let halvings: Vec<u32> = levels.iter().map(|l| l.halvings).collect();
+        let halvings = halvings(levels);
         sequences(levels).iter().all(|(q, scale)| least_after_cut(q, &halvings, *scale).is_some_and(|e| e < target))
     }
 
@@ -82,6 +82,11 @@ impl Estimate {
         }
         v
     }
+}
+
+/// Each level's halvings ([`Level::halvings`]), for the crossing guard.
+fn halvings(levels: &[Level]) -> Vec<u32> {
+    levels.iter().map(|l| l.halvings).collect()
 }
 
 /// Each target value's sequence over `levels` with the scale its error is taken relative

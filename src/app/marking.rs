@@ -90,8 +90,12 @@ pub(super) fn longest_edges(mesh: &Mesh) -> Vec<f64> {
 /// theirs (a triangle of a Kuhn cell of size h has its longest edge h sqrt 2, or h one
 /// bisection further; both halve to h/2 and keep h). `edges`: [`longest_edges`].
 pub(super) fn next_field(mesh: &Mesh, edges: &[f64], marked: &[bool], growth: f64) -> SizeField {
-    let sizes: Vec<f64> = edges.iter().zip(marked).map(|(&e, &m)| if m { 0.5 * e } else { e }).collect();
-    field_of_sizes(mesh, &sizes, growth)
+    field_of_sizes(mesh, &halved(edges, marked), growth)
+}
+
+/// Each triangle's size with the `marked` ones halved (`edges`: [`longest_edges`]).
+fn halved(edges: &[f64], marked: &[bool]) -> Vec<f64> {
+    edges.iter().zip(marked).map(|(&e, &m)| if m { 0.5 * e } else { e }).collect()
 }
 
 /// The size field with every contact triangle at the dyadic size of `sizes[t]` (units of a,
@@ -287,17 +291,17 @@ pub(super) fn goal_mark(
 /// of its indicator where the fields are no better than Lipschitz (the slowest an indicator
 /// of P2 fields falls: 1/4 from the area, 1/2 from the residual's density, 1/2 from the
 /// adjoint's surplus), so its children would still be marked at the next level; quartering
-/// now saves that level. On table2-ue2 the 0.0625 a level quarters 4 of its 115 marked
-/// triangles, the notch of the side lobe where hm sits, and the next level's hm error falls
-/// from -0.73 % to +0.25 % for 5 % more unknowns (docs/accuracy.md, "Quartering where
-/// halving is not enough").
+/// now saves that level. On table2-ue2 at target 0.02 the 0.0625 a level quarters 10 of its
+/// 115 marked triangles, the notch of the side lobe where hm sits, and the next level's hm
+/// error falls from -0.73 % to +0.35 % for 9 % more unknowns (docs/accuracy.md,
+/// "Quartering where halving is not enough").
 pub const QUARTER_RATIO: f64 = 16.0;
 
 /// A level quarters only when one of its estimated errors exceeds this many times the
 /// target: quartering saves a level only when more than one level of halving is still
 /// ahead, and one halving takes an error down by about 4 (second order, as hc and hm
 /// converge on the adaptive levels). Without the guard, M = 20, L = 10 at target 0.01
-/// quartered its 0.0625 a level, whose estimates (0.88 %, 0.01 %) were already below the
+/// quartered its 0.0625 a level, whose estimates (0.89 %, 0.17 %) were already below the
 /// target, into a 0.0156 a level that needs the raised gradient-jump factor: 229 s against
 /// 28 s for the same films. Level 0 has no estimate and halves.
 pub const QUARTER_ESTIMATE: f64 = 4.0;
@@ -319,14 +323,29 @@ impl Marking {
         Marking { marked, ranked: None, quarter: false }
     }
 
+    /// The indicator from which a marked triangle is quartered ([`QUARTER_RATIO`] times the
+    /// whole marking's smallest), when the marking quarters.
+    fn quarter_from(&self) -> Option<f64> {
+        let r = self.ranked.as_ref().filter(|_| self.quarter)?;
+        Some(QUARTER_RATIO * r.last().map_or(0.0, |v| v.1))
+    }
+
     /// The marked triangles the next level quarters (their count).
     pub fn quartered(&self) -> usize {
-        match &self.ranked {
-            Some(r) if self.quarter => {
-                let least = r.last().map_or(0.0, |v| v.1);
-                r.iter().filter(|v| v.1 >= QUARTER_RATIO * least).count()
-            }
+        match (&self.ranked, self.quarter_from()) {
+            (Some(r), Some(from)) => r.iter().filter(|v| v.1 >= from).count(),
             _ => 0,
+        }
+    }
+
+    /// How many halvings the next level's finest refinement makes ([`super::adapt::Level`]'s
+    /// `halvings`): 2 when it quarters triangles, else 1. A cut keeps the largest, so it
+    /// quarters whenever the whole marking does.
+    pub fn halvings(&self) -> u32 {
+        if self.quartered() > 0 {
+            2
+        } else {
+            1
         }
     }
 
@@ -336,21 +355,11 @@ impl Marking {
     /// or a quarter when the marking quarters ([`QUARTER_RATIO`], against the whole
     /// marking's smallest indicator), the others at theirs.
     pub fn sizes(&self, edges: &[f64], count: Option<usize>) -> Vec<f64> {
+        let Some(r) = &self.ranked else { return halved(edges, &self.marked) };
+        let from = self.quarter_from().unwrap_or(f64::INFINITY);
         let mut sizes = edges.to_vec();
-        match &self.ranked {
-            Some(r) => {
-                let least = r.last().map_or(0.0, |v| v.1);
-                for &(t, eta) in r.iter().take(count.unwrap_or(r.len())) {
-                    sizes[t] *= if self.quarter && eta >= QUARTER_RATIO * least { 0.25 } else { 0.5 };
-                }
-            }
-            None => {
-                for (s, &m) in sizes.iter_mut().zip(&self.marked) {
-                    if m {
-                        *s *= 0.5;
-                    }
-                }
-            }
+        for &(t, eta) in r.iter().take(count.unwrap_or(r.len())) {
+            sizes[t] *= if eta >= from { 0.25 } else { 0.5 };
         }
         sizes
     }
