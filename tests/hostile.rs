@@ -234,6 +234,29 @@ fn cases(dir: &Path) -> Vec<Case> {
     );
     bad_value.own_output = true;
     v.push(bad_value);
+    // The same value from PETSC_OPTIONS and from an options file: named too, from PETSc's
+    // options database rather than the command line.
+    let env_out = dir.join("out-petsc-option-bad-value-in-environment").display().to_string();
+    let mut in_env = case(
+        "petsc-option-bad-value-in-environment",
+        &[&t2, "--set", "mesh.contact_size=1", "--output", &env_out],
+        2,
+        &["'-elastic_mat_mumps_icntl_14 abc'", "Input string abc"],
+    );
+    in_env.env.push(("PETSC_OPTIONS", s("-elastic_mat_mumps_icntl_14 abc")));
+    in_env.own_output = true;
+    v.push(in_env);
+    let opts = dir.join("bad.opts");
+    std::fs::write(&opts, "-elastic_mat_mumps_icntl_14 abc\n").unwrap();
+    let file_out = dir.join("out-petsc-option-bad-value-in-file").display().to_string();
+    let mut in_file = case(
+        "petsc-option-bad-value-in-file",
+        &[&t2, "--set", "mesh.contact_size=1", "-options_file", opts.to_str().unwrap(), "--output", &file_out],
+        2,
+        &["'-elastic_mat_mumps_icntl_14 abc'", "Input string abc"],
+    );
+    in_file.own_output = true;
+    v.push(in_file);
     // The solver's own options are read after PETSc starts, on every rank alike.
     v.push(case(
         "ehl-option-not-a-number",

@@ -32,8 +32,7 @@ use super::estimate::Estimate;
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, Setup};
 use super::marking::{
-    cut_count, field_of_sizes, goal_mark, goals, longest_edges, next_field, zone_mark, Marking, TimeLeft, MIN_BUDGET_SHARE,
-    QUARTER_ESTIMATE,
+    cut_count, goal_mark, goals, longest_edges, next_field, zone_mark, Marking, NextMesh, TimeLeft, MIN_BUDGET_SHARE, QUARTER_ESTIMATE,
 };
 use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
@@ -43,7 +42,6 @@ use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, Ramp
 use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
 use crate::friction::pass::FrictionResult;
-use crate::mesh::size_field::SizeField;
 use serde_json::json;
 use std::sync::Arc;
 use std::time::Instant;
@@ -147,10 +145,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         acc.max_unknowns
     ));
     let mut levels: Vec<Level> = Vec::new();
-    let mut field: Option<Arc<SizeField>> = None;
-    // How many halvings the finest refinement of `field` makes: 2 where its marking
-    // quartered triangles ([`Level::halvings`]).
-    let mut halvings = 1;
+    // The next level's size field with its halvings (None: the scene's own mesh).
+    let mut next: Option<NextMesh> = None;
     let mut previous: Option<Solved> = None;
     let growth = scene.mesh.growth;
     // Tries of the first level on a finer mesh after it failed on the scene's own.
@@ -176,7 +172,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // The level being solved: one per converged level (a retried first level stays 0).
         let k = levels.len();
         let t0 = Instant::now();
-        let setup = match Setup::with_size_field(ctx, scene, field.clone()) {
+        let setup = match Setup::with_size_field(ctx, scene, next.as_ref().map(|m| m.field.clone())) {
             Ok(s) => s,
             Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
         };
@@ -199,8 +195,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 m.quartered()
             ));
             m.quarter = false;
-            field = Some(Arc::new(field_of_sizes(&prev.setup.mesh, &m.sizes(&longest_edges(&prev.setup.mesh), None), growth)));
-            halvings = 1;
+            next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), m, None, growth));
             continue;
         }
         if let (Some(prev), true) = (&previous, n > budget) {
@@ -231,9 +226,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         "accuracy: {over_what}; it refines the {count} of the {marked} marked triangles with the largest indicator instead ({:.0} % of their indicator)",
                         100.0 * share
                     ));
-                    field =
-                        Some(Arc::new(field_of_sizes(&prev.setup.mesh, &m.sizes(&longest_edges(&prev.setup.mesh), Some(count)), growth)));
-                    halvings = m.halvings();
+                    next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), m, Some(count), growth));
                     cut = Some(Cut { count, share, by: if by_time.is_some() { Budget::Seconds } else { Budget::Unknowns } });
                     continue;
                 }
@@ -369,8 +362,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         ));
                         let edges = longest_edges(&prev.setup.mesh);
                         let marked = zone_mark(&pf, &edges);
-                        field = Some(Arc::new(next_field(&prev.setup.mesh, &edges, &marked, growth)));
-                        halvings = 1;
+                        next = Some(NextMesh::halving(Arc::new(next_field(&prev.setup.mesh, &edges, &marked, growth))));
                         zone_retry = None;
                         tried_s += t0.elapsed().as_secs_f64();
                         continue;
@@ -402,7 +394,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 Err(e) if crate::interrupt::agreed() == 0 && first_retries < FIRST_LEVEL_RETRIES && newton_failed(ctx, &e) => {
                     let why = format!("did not converge on its mesh ({})", reason(&e));
                     let closed = closures(ctx, &e);
-                    field = Some(first_level_again(ctx, &setup.mesh, growth, &why, &closed));
+                    next = Some(NextMesh::halving(first_level_again(ctx, &setup.mesh, growth, &why, &closed)));
                     if !closed.is_empty() {
                         without_gradient_jump(ctx, &mut own);
                     }
@@ -436,7 +428,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             // unknowns and stopped at the budget one level earlier (fx 1.46 %, fz 1.37 %);
             // the halved zone has 92,600 and gets a level further (1.31 %, 1.03 %), with
             // the same films.
-            field = Some(first_level_again(ctx, &setup.mesh, growth, &why, &[]));
+            next = Some(NextMesh::halving(first_level_again(ctx, &setup.mesh, growth, &why, &[])));
             first_retries += 1;
             tried_s += t0.elapsed().as_secs_f64();
             drop(solver);
@@ -469,7 +461,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             friction: friction.as_ref().map(|f| [f.fx, f.fz]),
             est: None,
             cut: cut.take(),
-            halvings: if k == 0 { 1 } else { halvings },
+            halvings: if k == 0 { 1 } else { next.as_ref().map_or(1, |m| m.halvings) },
         };
         over.clear();
         levels.push(level);
@@ -583,8 +575,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             let why = short_of(target, &format!("every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"), k, est);
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
-        field = Some(Arc::new(field_of_sizes(&here.setup.mesh, &marking.sizes(&edges, None), growth)));
-        halvings = marking.halvings();
+        next = Some(NextMesh::marked(&here.setup.mesh, &edges, marking, None, growth));
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
             return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
         }

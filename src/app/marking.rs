@@ -21,6 +21,7 @@ use crate::mesh::Mesh;
 use crate::reynolds::estimate::{dorfler_mark, element_residual};
 use crate::reynolds::jump::{edge_terms, jump_coefficient, triangle_shares, EdgeJump};
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// A contact triangle with a nodal pressure above this (units of p_H) is in the
@@ -374,6 +375,27 @@ impl Marking {
         } else {
             1.0
         }
+    }
+}
+
+/// The next level's mesh: its size field and the halvings its finest refinement makes
+/// ([`super::adapt::Level`]'s `halvings`, for the estimate's crossing guard), kept in one
+/// value so that every way of making the field says how far it refines.
+pub(super) struct NextMesh {
+    pub field: Arc<SizeField>,
+    pub halvings: u32,
+}
+
+impl NextMesh {
+    /// A field that refines by one halving at most (zone marking, a retried first level).
+    pub fn halving(field: Arc<SizeField>) -> NextMesh {
+        NextMesh { field, halvings: 1 }
+    }
+
+    /// The field of `marking` on `mesh` (`edges`: [`longest_edges`]) when its `count`
+    /// triangles of largest indicator are refined (all with `None`): [`Marking::sizes`].
+    pub fn marked(mesh: &Mesh, edges: &[f64], marking: &Marking, count: Option<usize>, growth: f64) -> NextMesh {
+        NextMesh { field: Arc::new(field_of_sizes(mesh, &marking.sizes(edges, count), growth)), halvings: marking.halvings() }
     }
 }
 

@@ -148,7 +148,9 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             let all_failed = collective::all(&ctx.world, failed_here);
             // A value of one of the user's PETSc options that PETSc rejected when it read it
             // (a solver is set up only when it is first used): bad input, named.
-            let quoted = cli::options_quoted(&opts.petsc_args, &e.to_string());
+            // The whole database: PETSC_OPTIONS and options files too, not only the command line.
+            let given = crate::petsc::options::given().unwrap_or_else(|_| opts.petsc_args.clone());
+            let quoted = cli::options_quoted(&given, &e.to_string());
             // The rank that read the option may be alone with PETSc's message (rank 0's
             // condensation): every rank ends with the same code.
             let bad_option = !collective::all(&ctx.world, quoted.is_empty());

@@ -54,6 +54,40 @@ pub fn set_ours(name: &str, value: &str) -> Result<()> {
     set_value(name, value)
 }
 
+/// The options in the database that our code did not set, as PETSc lists them
+/// (`PetscOptionsGetAll`: `-name value` words): the command line's, and those of
+/// `PETSC_OPTIONS` and of options files, which the program's own arguments do not show.
+pub fn given() -> Result<Vec<String>> {
+    let mut all: *mut std::os::raw::c_char = std::ptr::null_mut();
+    pcall!(super::ffi::PetscOptionsGetAll(std::ptr::null_mut(), &mut all))?;
+    if all.is_null() {
+        return Ok(Vec::new());
+    }
+    let text = unsafe { std::ffi::CStr::from_ptr(all) }.to_string_lossy().into_owned();
+    // PetscFree(all): PetscFreeA takes the address of each pointer it frees and sets it to
+    // null (line, function and file are for PETSc's malloc debugging only).
+    let (func, file) = (cstr("options::given"), cstr(file!()));
+    pcall!(super::ffi::PetscFreeA(1, line!() as i32, func.as_ptr(), file.as_ptr(), (&mut all as *mut *mut std::os::raw::c_char).cast()))?;
+    Ok(users_words(&text, &OURS.lock().unwrap_or_else(|e| e.into_inner())))
+}
+
+/// The words of PETSc's option listing `text` without the options named in `ours` (with
+/// their values).
+fn users_words(text: &str, ours: &std::collections::BTreeSet<String>) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut skip = false;
+    for w in text.split_whitespace() {
+        let is_name = w.starts_with('-') && w.len() > 1 && !w[1..].starts_with(|c: char| c.is_ascii_digit() || c == '.');
+        if is_name {
+            skip = ours.contains(w);
+        }
+        if !skip {
+            out.push(w.to_string());
+        }
+    }
+    out
+}
+
 /// Reads an option's value as a string, if set.
 pub fn get_string(name: &str) -> Result<Option<String>> {
     let n = cstr(name);
@@ -184,4 +218,19 @@ pub fn unused() -> Result<Vec<(String, Option<String>)>> {
     }
     pcall!(super::ffi::PetscOptionsLeftRestore(std::ptr::null_mut(), &mut n, &mut names, &mut values))?;
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_users_options_are_the_listing_without_ours() {
+        let ours: std::collections::BTreeSet<String> = ["-pc_type".to_string(), "-ksp_rtol".to_string()].into();
+        let text = "-ksp_rtol 1e-9 -pc_type lu -snes_max_it abc -ehl_shift -1.5 -snes_monitor -pc_factor_shift_amount -.5";
+        assert_eq!(
+            users_words(text, &ours),
+            ["-snes_max_it", "abc", "-ehl_shift", "-1.5", "-snes_monitor", "-pc_factor_shift_amount", "-.5"]
+        );
+    }
 }
