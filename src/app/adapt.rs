@@ -7,7 +7,8 @@
 //!    error in each triangle moves them); with `marking` 0, every
 //!    triangle of the pressurised zone (a nodal pressure above 0.01 p_H). Halve their size
 //!    (quarter it for those whose indicator is 16 times the smallest marked one, while an
-//!    estimate is above 4 times the target: `marking::QUARTER_RATIO`), keep the others'
+//!    estimate is above 4 times the target, Newton reached the level without a
+//!    continuation and fz is no target: `marking::quarters`), keep the others'
 //!    (a graded size field on the face, [`crate::mesh::size_field`]), and mesh the solid
 //!    anew under it (conforming bisection).
 //! 3. Solve from the previous level's pressure, interpolated (mesh sequencing), and after a
@@ -32,7 +33,7 @@ use super::estimate::Estimate;
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, Setup};
 use super::marking::{
-    cut_count, goal_mark, goals, longest_edges, next_field, zone_mark, Marking, NextMesh, TimeLeft, MIN_BUDGET_SHARE, QUARTER_ESTIMATE,
+    cut_count, goal_mark, goals, longest_edges, next_field, quarters, zone_mark, Marking, NextMesh, TimeLeft, MIN_BUDGET_SHARE,
 };
 use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
@@ -508,12 +509,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             _ => None,
         };
         let exponents = exponents.map(|got| super::sensitivity::report(ctx, got));
-        // Quartering pays only with more than one level of halving still ahead, and not
-        // while fz is a target (friction on a full domain: spin), whose error is spread
-        // and falls at first order (docs/accuracy.md, "Quartering where halving is not
-        // enough": spin-0.5deg).
         let fz_target = friction.is_some() && !setup.half;
-        let quarter = !fz_target && est.is_some_and(|e| e.values().iter().any(|&v| v > QUARTER_ESTIMATE * target));
+        let quarter = quarters(est.as_ref(), target, fz_target, sol.continued);
         let marked = if !last {
             Some(match adjoint.as_ref().filter(|_| goal) {
                 // A failed adjoint costs this level's goal-oriented marking, not the run (an

@@ -8,6 +8,7 @@
 //!   [`QUARTER_ESTIMATE`]).
 //! - Zone marking (`accuracy.marking = 0`): every triangle of the pressurised zone.
 use super::adapt::MIN_ADAPTIVE_SIZE;
+use super::estimate::Estimate;
 use super::Context;
 use crate::case::Scene;
 use crate::ehl::driver::{self, Adjoint};
@@ -307,6 +308,21 @@ pub const QUARTER_RATIO: f64 = 16.0;
 /// 28 s for the same films. Level 0 has no estimate and halves.
 pub const QUARTER_ESTIMATE: f64 = 4.0;
 
+/// Whether a level's marking quarters ([`QUARTER_RATIO`]), from the level's estimate
+/// `est` (None on the first level), the `target`, whether fz is a target (`fz_target`:
+/// friction on a full domain) and whether Newton reached the level only through a
+/// continuation (`continued`). Quartering pays only with more than one level of halving
+/// still ahead ([`QUARTER_ESTIMATE`]); not while fz is a target, whose error is spread and
+/// falls at first order (cases/hard/spin-0.5deg stopped short of 0.01 with it); and not
+/// after a continuation: a quartered level starts from a pressure interpolated across two
+/// halvings, and where one halving already needed a continuation, the quartered level's
+/// first try failed on five points of the Moes map (M = 500, L = 20: 712 s against 132 s
+/// halving; M = 1000, L = 15: 804 s against 308 s; docs/accuracy.md, "Quartering where
+/// halving is not enough").
+pub(super) fn quarters(est: Option<&Estimate>, target: f64, fz_target: bool, continued: bool) -> bool {
+    !fz_target && !continued && est.is_some_and(|e| e.values().iter().any(|&v| v > QUARTER_ESTIMATE * target))
+}
+
 /// The triangles a level marks for the next one, and, when the marking ranks them
 /// (goal-oriented), the marked ones by decreasing indicator with their indicator: the next
 /// level can then be cut to its budget ([`cut_count`]), and the marked triangles of
@@ -584,5 +600,26 @@ mod tests {
         assert_eq!(m.sizes(&[0.25; 4], None), vec![0.125; 4]);
         // Zone marking has no ranking: every marked triangle is halved.
         assert_eq!(Marking::unranked(vec![true, false]).quartered(), 0);
+    }
+
+    #[test]
+    fn a_level_quarters_only_far_from_the_target_after_plain_newton_and_without_fz() {
+        // table2-ue2's level 2 at target 0.01: estimates 16 % and 43 %, plain Newton.
+        let far = Estimate { hc: 0.16, hm: 0.43, friction: None };
+        assert!(quarters(Some(&far), 0.01, false, false));
+        // Its level 3 at 0.18 % and 0.47 %: within 4 times the target, one halving ahead.
+        let near = Estimate { hc: 0.0018, hm: 0.0047, friction: None };
+        assert!(!quarters(Some(&near), 0.01, false, false));
+        // ... but more than one at target 0.001.
+        assert!(quarters(Some(&near), 0.001, false, false));
+        // Level 0 has no estimate; a level reached through a continuation, or with fz
+        // among the targets, halves.
+        assert!(!quarters(None, 0.01, false, false));
+        assert!(!quarters(Some(&far), 0.01, false, true));
+        let spin = Estimate { hc: 0.05, hm: 0.05, friction: Some([0.01, 0.2]) };
+        assert!(!quarters(Some(&spin), 0.01, true, false));
+        // One estimate far off is enough (fx among them).
+        let fx = Estimate { hc: 0.001, hm: 0.001, friction: Some([0.05, 0.0]) };
+        assert!(quarters(Some(&fx), 0.01, false, false));
     }
 }
