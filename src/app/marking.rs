@@ -315,10 +315,11 @@ pub const QUARTER_ESTIMATE: f64 = 4.0;
 /// still ahead ([`QUARTER_ESTIMATE`]); not while fz is a target, whose error is spread and
 /// falls at first order (cases/hard/spin-0.5deg stopped short of 0.01 with it); and not
 /// after a continuation: a quartered level starts from a pressure interpolated across two
-/// halvings, and where one halving already needed a continuation, the quartered level's
-/// first try failed on five points of the Moes map (M = 500, L = 20: 712 s against 132 s
-/// halving; M = 1000, L = 15: 804 s against 308 s; docs/accuracy.md, "Quartering where
-/// halving is not enough").
+/// halvings, and where one halving already needed a continuation, the quartered level cost
+/// far more than it saved on six of the nine Moes points where it happened (M = 500,
+/// L = 20: 712 s against 132 s halving; M = 1000, L = 15: 804 s against 308 s; it paid on
+/// three, M = 1000, L = 5: 218 s against 453 s; 2,989 s against 2,278 s over the nine;
+/// docs/accuracy.md, "Quartering where halving is not enough").
 pub(super) fn quarters(est: Option<&Estimate>, target: f64, fz_target: bool, continued: bool) -> bool {
     !fz_target && !continued && est.is_some_and(|e| e.values().iter().any(|&v| v > QUARTER_ESTIMATE * target))
 }
