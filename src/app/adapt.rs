@@ -7,8 +7,9 @@
 //!    error in each triangle moves them); with `marking` 0, every
 //!    triangle of the pressurised zone (a nodal pressure above 0.01 p_H). Halve their size
 //!    (quarter it for those whose indicator is 16 times the smallest marked one, while an
-//!    estimate is above 4 times the target, Newton reached the level without a
-//!    continuation and fz is no target: `marking::quarters`), keep the others'
+//!    estimate is above 4 times the target, the target is 0.005 or more, Newton reached
+//!    the level without a continuation and fz is no target: `marking::quarters`), keep
+//!    the others'
 //!    (a graded size field on the face, [`crate::mesh::size_field`]), and mesh the solid
 //!    anew under it (conforming bisection).
 //! 3. Solve from the previous level's pressure, interpolated (mesh sequencing), and after a
