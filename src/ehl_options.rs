@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 pub struct EhlOptions {
     /// `-ehl_monitor`: per-iteration diagnostics on stderr (residual norms per block, the
     /// worst residual rows, the film step limiter and its binding node, clipped pressure
-    /// steps, the condensation's phases).
+    /// steps, the condensation's phases, the iterate's central and minimum film).
     pub monitor: bool,
     /// `-ehl_check_jacobian`: a block-by-block finite-difference check of the monolithic
     /// Jacobian at the start (the condensed coupling: `-snes_test_jacobian`).
@@ -79,8 +79,11 @@ pub fn read(comm: petsc::ffi::MPI_Comm) -> petsc::Result<&'static EhlOptions> {
     }
     let d = EhlOptions::default();
     let mut g = petsc::options::Group::begin(comm, "EHL solver options", "EHL")?;
-    let monitor =
-        g.bool("-ehl_monitor", "Print Newton diagnostics per iteration (block residual norms, worst rows, film limiter)", d.monitor)?;
+    let monitor = g.bool(
+        "-ehl_monitor",
+        "Print Newton diagnostics per iteration (block residual norms, worst rows, film limiter, the iterate's hc and hm)",
+        d.monitor,
+    )?;
     let check_jacobian = g.bool(
         "-ehl_check_jacobian",
         "Check the monolithic Jacobian block by block against finite differences at the start",

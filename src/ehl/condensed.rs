@@ -553,6 +553,14 @@ impl Problem for CondensedSystem<'_> {
                     );
                 }
                 eprintln!("{msg}");
+                if self.rank == 0 {
+                    let centre = (0..h.len())
+                        .filter_map(|k| self.face_xz(k).map(|c| (k, c[0].hypot(c[1]))))
+                        .min_by(|a, b| a.1.total_cmp(&b.1))
+                        .map(|(k, _)| h[k]);
+                    let hm = h.iter().copied().fold(f64::INFINITY, f64::min);
+                    eprintln!("ehl_monitor: iterate films nodal hc = {:.6e} min nodal H = {hm:.6e} (H)", centre.unwrap_or(f64::NAN));
+                }
             }
         }
         let idx: Vec<i32> = (lo as i32..hi as i32).collect();

@@ -479,6 +479,8 @@ impl Problem for EhlSystem<'_> {
                     x[self.layout.p[worst_at] as usize],
                     self.layout.film(self.mesh, x, worst_at as u32)
                 );
+                let st = super::post::FieldsOnFace::new(self.mesh, self.layout, x).stats();
+                eprintln!("ehl_monitor: iterate films hc = {:.6e} hm = {:.6e} (H)", st.hc, st.hm);
             }
         }
         Ok(Eval::Ok)
