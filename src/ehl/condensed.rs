@@ -554,12 +554,11 @@ impl Problem for CondensedSystem<'_> {
                 }
                 eprintln!("{msg}");
                 if self.rank == 0 {
-                    let centre = (0..h.len())
-                        .filter_map(|k| self.face_xz(k).map(|c| (k, c[0].hypot(c[1]))))
-                        .min_by(|a, b| a.1.total_cmp(&b.1))
-                        .map(|(k, _)| h[k]);
+                    let hc = mesh.locate_contact(0.0, 0.0).map_or(f64::NAN, |(t, b)| {
+                        crate::fem::p2_tri_eval(&mesh.contact_tris[t].map(|n| h[self.layout.face_index[n as usize] as usize]), b)
+                    });
                     let hm = h.iter().copied().fold(f64::INFINITY, f64::min);
-                    eprintln!("ehl_monitor: iterate films nodal hc = {:.6e} min nodal H = {hm:.6e} (H)", centre.unwrap_or(f64::NAN));
+                    eprintln!("ehl_monitor: iterate films hc = {hc:.6e} min nodal H = {hm:.6e} (H)");
                 }
             }
         }
