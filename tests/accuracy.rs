@@ -8,7 +8,7 @@ use common::*;
 /// when none was written).
 fn moes_m10(name: &str, set: &[&str]) -> (std::process::Output, serde_json::Value) {
     let dir = scratch(name);
-    let scene = repo().join("cases/examples/moes-m10-l6.toml");
+    let scene = repo().join("cases/references/moes-m10-l6.toml");
     let run = dir.join("run");
     let args =
         [scene.to_str().unwrap(), "--output", run.to_str().unwrap(), "--set", "accuracy.target=0.05", "--set", "mesh.contact_size=0.5"];
@@ -28,7 +28,7 @@ fn moes_m10(name: &str, set: &[&str]) -> (std::process::Output, serde_json::Valu
 #[test]
 fn the_film_adjoints_predict_how_the_films_change_with_speed() {
     let dir = scratch("accuracy_adjoint");
-    let scene = repo().join("cases/examples/moes-m10-l6.toml");
+    let scene = repo().join("cases/references/moes-m10-l6.toml");
     let solve = |name: &str, ue: f64| {
         let run = dir.join(name);
         let ue = format!("operating.entrainment_speed={ue}");
