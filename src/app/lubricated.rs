@@ -161,7 +161,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     for part in ["simulated", "skipped"] {
         ctx.log(format!("{part}: {}", report[part].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect::<Vec<_>>().join("; ")));
     }
-    let mut solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
+    let mut solver = EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half, earlier.is_some())?;
     // The speed exponents' adjoint, right after the solve, solves on Newton's factorisation.
     solver.keep_newton(scene.output.speed_exponents && !scene.is_sweep());
     if scene.is_sweep() {

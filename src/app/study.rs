@@ -200,12 +200,12 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
         let dir = ctx.out_dir.join(format!("level_{}", k + 1));
         ctx.create_dir(&dir)?;
         let setup = Setup::new(ctx, &sc)?;
-        let solver = EhlSolver::new(ctx, &sc, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half)?;
-        let (n_u, n_p) = setup.layout.counts();
         let earlier = match (&last_converged, sequence) {
             (Some(d), true) => Some(super::restart::EarlierRun::read(d)?),
             _ => None,
         };
+        let solver = EhlSolver::new(ctx, &sc, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half, earlier.is_some())?;
+        let (n_u, n_p) = setup.layout.counts();
         let solved = match &earlier {
             Some(e) => e.solve(ctx, &sc, &solver),
             None => solver.solve(ctx, &sc, None),

@@ -51,6 +51,17 @@ pub const AUTO_MONOLITHIC_ABOVE: usize = 4000;
 /// about 5.6 s; the dense LU grows as n^3, so the two meet near 8,000.
 pub const AUTO_MONOLITHIC_ABOVE_SWEEP: usize = 8000;
 
+/// The same for a solve that starts with plain Newton from a coarser mesh's pressure (an
+/// adaptive level after one that plain Newton solved, `--start-from`, a sequenced study):
+/// Newton takes 7-19 steps from there, the monolithic ones on an LU reused over three
+/// steps, and the condensation, 4-7 s at 2,700-3,700 pressure unknowns, is not paid back.
+/// Adaptive levels at 2 ranks (docs/performance.md, "Couplings"): at 1,476-1,956 pressure
+/// unknowns the condensed level is faster (table2-ue2's level 1: 4.2 s against 7.8 s), at
+/// 2,706-3,748 the monolithic one (its level 2: 7.1 s against 12.9 s), and the next
+/// monolithic level starts from its displacement. A level that goes to the continuation at
+/// once keeps [`AUTO_MONOLITHIC_ABOVE`]: its many steps pay the condensation back.
+pub const AUTO_MONOLITHIC_ABOVE_SEQUENCED: usize = 2500;
+
 /// Default dimensionless cavitation penalty factor xi.
 pub const DEFAULT_PENALTY: f64 = 1e4;
 
@@ -138,7 +149,7 @@ pub const REYNOLDS_FIELDS: &[Field] = &[
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0")),
     f!("gradient_jump", "gradient-jump factor c_J: the pressure-slope jumps across the contact edges are penalised with gamma = c_J kappa |v| min(h, a/32)^3 (consistent: zero for a smooth pressure; removes the node-to-node wiggles of the P2 pressure in the Hertz zone; an adaptive level that does not converge with a factor below 1 is solved again with 1; 0 = off)", "",
         Kind::Number(Range::AtLeast(0.0)), Presence::Default("0; 0.01 when refined to an accuracy target without a [mesh] table")),
-    f!("coupling", "how Newton couples film and solid: the elastic block condensed onto the contact face (dense LU, fast on small meshes) or one sparse monolithic matrix (MUMPS; fast on fine meshes); auto = condensed up to 4,000 pressure unknowns (a sweep: 8,000)", "",
+    f!("coupling", "how Newton couples film and solid: the elastic block condensed onto the contact face (dense LU, fast on small meshes) or one sparse monolithic matrix (MUMPS; fast on fine meshes); auto = condensed up to 4,000 pressure unknowns (a sweep: 8,000; plain Newton from a coarser mesh's pressure, such as an adaptive level: 2,500)", "",
         Kind::Choice(Coupling::NAMES), Presence::Default("\"auto\"")),
 ];
 

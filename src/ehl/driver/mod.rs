@@ -92,8 +92,9 @@ pub(super) struct Kept<'a> {
 
 impl<'a> EhlSolver<'a> {
     /// Condenses the elastic block onto the contact face, unless the scene's
-    /// `reynolds.coupling` (see [`Coupling::of_scene`]) asks for the monolithic system.
-    /// Collective.
+    /// `reynolds.coupling` (see [`Coupling::of_scene`]) asks for the monolithic system;
+    /// `sequenced`: the solves start from a coarser mesh's pressure. Collective.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Context,
         scene: &Scene,
@@ -102,10 +103,11 @@ impl<'a> EhlSolver<'a> {
         dofs: &'a DofMap,
         layout: &'a Layout,
         half: bool,
+        sequenced: bool,
     ) -> Result<Self, Error> {
         set_newton_defaults(scene.accuracy.target)?;
         let p_nodes = pressure_nodes(mesh, layout);
-        let coupling = Coupling::of_scene(scene, p_nodes.len());
+        let coupling = Coupling::of_scene(scene, p_nodes.len(), sequenced);
         let (rigid, monolithic) = (coupling == Coupling::Rigid, coupling == Coupling::Monolithic);
         if monolithic {
             ctx.log(format!("coupling: monolithic (reynolds.coupling = \"{}\", {} pressure unknowns): U, P and H0 in one sparse matrix, a MUMPS LU at every Newton step (every third step, GMRES in between, from a start near the solution)", scene.reynolds.coupling, p_nodes.len()));
@@ -218,7 +220,7 @@ pub fn solve(
     layout: &Layout,
     half: bool,
 ) -> Result<EhlSolution, Error> {
-    EhlSolver::new(ctx, scene, mesh, part, dofs, layout, half)?.solve(ctx, scene, None)
+    EhlSolver::new(ctx, scene, mesh, part, dofs, layout, half, false)?.solve(ctx, scene, None)
 }
 
 /// The face nodes that carry a pressure unknown in the condensed system, in

@@ -17,12 +17,13 @@ pub enum Coupling {
 }
 
 impl Coupling {
-    /// The coupling for `scene` with `n_p` pressure unknowns: rigid solids are rigid, else
-    /// the scene's `reynolds.coupling` (`monolithic`).
-    pub fn of_scene(scene: &Scene, n_p: usize) -> Coupling {
+    /// The coupling for `scene` with `n_p` pressure unknowns, solved from a coarser mesh's
+    /// pressure or not (`sequenced`): rigid solids are rigid, else the scene's
+    /// `reynolds.coupling` (`monolithic`).
+    pub fn of_scene(scene: &Scene, n_p: usize, sequenced: bool) -> Coupling {
         if scene.effects.elasticity == crate::case::ElasticityModel::Rigid {
             Coupling::Rigid
-        } else if monolithic(scene.reynolds.coupling, n_p, scene.is_sweep()) {
+        } else if monolithic(scene.reynolds.coupling, n_p, scene.is_sweep(), sequenced) {
             Coupling::Monolithic
         } else {
             Coupling::Condensed
@@ -39,14 +40,19 @@ impl Coupling {
     }
 }
 
-/// Whether `coupling` with `n_p` pressure unknowns (in a `sweep` or not) means the
-/// monolithic system.
-pub(super) fn monolithic(coupling: crate::case::Coupling, n_p: usize, sweep: bool) -> bool {
-    use crate::case::Coupling as C;
+/// Whether `coupling` with `n_p` pressure unknowns (in a `sweep` or not, solved from a
+/// coarser mesh's pressure or not) means the monolithic system.
+pub(super) fn monolithic(coupling: crate::case::Coupling, n_p: usize, sweep: bool, sequenced: bool) -> bool {
+    use crate::case::{Coupling as C, AUTO_MONOLITHIC_ABOVE, AUTO_MONOLITHIC_ABOVE_SEQUENCED, AUTO_MONOLITHIC_ABOVE_SWEEP};
+    let above = match (sweep, sequenced) {
+        (true, _) => AUTO_MONOLITHIC_ABOVE_SWEEP,
+        (false, true) => AUTO_MONOLITHIC_ABOVE_SEQUENCED,
+        (false, false) => AUTO_MONOLITHIC_ABOVE,
+    };
     match coupling {
         C::Monolithic => true,
         C::Condensed => false,
-        C::Auto => n_p > if sweep { crate::case::AUTO_MONOLITHIC_ABOVE_SWEEP } else { crate::case::AUTO_MONOLITHIC_ABOVE },
+        C::Auto => n_p > above,
     }
 }
 
@@ -340,12 +346,17 @@ mod tests {
 
     #[test]
     fn auto_coupling_switches_to_monolithic_above_the_measured_crossover() {
-        use crate::case::{Coupling, AUTO_MONOLITHIC_ABOVE as N, AUTO_MONOLITHIC_ABOVE_SWEEP as NS};
-        assert!(!super::monolithic(Coupling::Auto, N, false));
-        assert!(super::monolithic(Coupling::Auto, N + 1, false));
-        assert!(!super::monolithic(Coupling::Auto, N + 1, true));
-        assert!(super::monolithic(Coupling::Auto, NS + 1, true));
-        assert!(!super::monolithic(Coupling::Condensed, 100 * N, false));
-        assert!(super::monolithic(Coupling::Monolithic, 10, true));
+        use crate::case::{Coupling, AUTO_MONOLITHIC_ABOVE as N, AUTO_MONOLITHIC_ABOVE_SEQUENCED as NQ, AUTO_MONOLITHIC_ABOVE_SWEEP as NS};
+        assert!(!super::monolithic(Coupling::Auto, N, false, false));
+        assert!(super::monolithic(Coupling::Auto, N + 1, false, false));
+        assert!(!super::monolithic(Coupling::Auto, N + 1, true, false));
+        assert!(super::monolithic(Coupling::Auto, NS + 1, true, false));
+        // From a coarser mesh's pressure the condensation is not paid back as early.
+        const { assert!(NQ < N) };
+        assert!(!super::monolithic(Coupling::Auto, NQ, false, true));
+        assert!(super::monolithic(Coupling::Auto, NQ + 1, false, true));
+        assert!(!super::monolithic(Coupling::Auto, NQ + 1, true, true));
+        assert!(!super::monolithic(Coupling::Condensed, 100 * N, false, true));
+        assert!(super::monolithic(Coupling::Monolithic, 10, true, false));
     }
 }
