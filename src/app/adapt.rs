@@ -32,7 +32,7 @@
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
 use super::estimate::Estimate;
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
-use super::lubricated::{post_point, Setup};
+use super::lubricated::{post_point, PointResult, Setup};
 use super::marking::{
     cut_count, goal_mark, goals, longest_edges, next_field, quarters, zone_mark, Marking, NextMesh, TimeLeft, MIN_BUDGET_SHARE,
 };
@@ -131,11 +131,23 @@ struct Solved {
     marking: Option<Marking>,
 }
 
+/// What an adaptive run wrote: its outcome, the last level's numbers and estimate, how many
+/// levels it solved and the unknowns of the last.
+pub struct Adapted {
+    pub outcome: Outcome,
+    pub point: PointResult,
+    pub estimate: Option<Estimate>,
+    pub levels: usize,
+    pub unknowns: usize,
+    /// Newton iterations of every level (the attempts that converged).
+    pub newton_iterations: usize,
+}
+
 /// Runs the adaptive loop of a lubricated single-point scene with `accuracy.target > 0`.
 /// Collective. When the target cannot be reached (`max_levels`, `max_unknowns`, every
 /// triangle at the smallest size) the last level's result is written with its estimated
-/// error and the returned [`Outcome::ShortOfTarget`] says why (exit 4).
-pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<Outcome, Error> {
+/// error and the returned outcome is [`Outcome::ShortOfTarget`], saying why (exit 4).
+pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<Adapted, Error> {
     // The scene as solved: the gradient-jump factor may be raised on the way (below).
     let mut own = scene.clone();
     let acc = scene.accuracy;
@@ -621,7 +633,7 @@ fn time_left(ctx: &Context, acc: crate::case::schema::Accuracy, levels: &[Level]
 /// After level `k` stopped with `e`: when the time budget was spent (and a level converged
 /// before), the last converged level's result, labelled as short of its target; any other
 /// error (a signal, a failure outside Newton) stops the run.
-fn out_of_time(ctx: &Context, scene: &Scene, prev: Option<&Solved>, k: usize, levels: &[Level], e: Error) -> Result<Outcome, Error> {
+fn out_of_time(ctx: &Context, scene: &Scene, prev: Option<&Solved>, k: usize, levels: &[Level], e: Error) -> Result<Adapted, Error> {
     match prev {
         // (`finish` clears the spent budget before it writes.)
         Some(prev) if crate::interrupt::agreed() == crate::interrupt::DEADLINE => {
@@ -657,7 +669,7 @@ fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<Frictio
 
 /// Writes the result of `done` (the last level solved) with the accuracy report; with a
 /// `shortfall` the report says the target was not reached and the run exits 4.
-fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Level], shortfall: Option<String>) -> Result<Outcome, Error> {
+fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Level], shortfall: Option<String>) -> Result<Adapted, Error> {
     // The budget bounds the refinement, not the writing of its result.
     crate::interrupt::clear_deadline();
     crate::interrupt::check("the Newton solve")?;
@@ -665,21 +677,31 @@ fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Le
     let mut scene = scene.clone();
     scene.reynolds.gradient_jump = done.gradient_jump;
     let scene = &scene;
-    ctx.write_results(|dir| {
-        post_point(ctx, scene, &done.setup, &done.sol, done.condensation_s, dir)?;
+    let point = ctx.write_results(|dir| {
+        let point = post_point(ctx, scene, &done.setup, &done.sol, done.condensation_s, dir)?;
         ctx.amend_summary(dir, |summary| {
             summary["accuracy"] = accuracy_report(target, levels, shortfall.as_deref());
             if let Some(e) = &done.exponents {
                 summary["speed_exponents"] = e.clone();
             }
-        })
+        })?;
+        Ok(point)
     })?;
-    Ok(match shortfall {
+    let outcome = match shortfall {
         Some(why) => {
             ctx.log(&why);
             Outcome::ShortOfTarget(why)
         }
         None => Outcome::Done,
+    };
+    let last = levels.last().expect("a level");
+    Ok(Adapted {
+        outcome,
+        point,
+        estimate: last.est,
+        levels: levels.len(),
+        unknowns: last.elastic_unknowns + last.pressure_unknowns + 1,
+        newton_iterations: levels.iter().map(|l| l.newton_iterations).sum(),
     })
 }
 

@@ -153,7 +153,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         ctx.log(format!("spin: the mean surface velocity turns about (0, {zc:.3}a){inside}"));
     }
     if scene.accuracy.target > 0.0 {
-        return super::adapt::run(ctx, scene, earlier);
+        if scene.is_sweep() {
+            return super::sweep::run_adaptive(ctx, scene);
+        }
+        return super::adapt::run(ctx, scene, earlier).map(|a| a.outcome);
     }
     let setup = Setup::new(ctx, scene)?;
     crate::interrupt::check("the mesh")?;

@@ -1,17 +1,29 @@
-//! Sweeps: one scene, several operating points (`[sweep]` lists of Ue, lambda, SRR). The
-//! mesh and the condensed elastic block are built once; each point starts from the
-//! previous converged state (and from the Hertz start when that fails). A point that fails
-//! is recorded with its reason and the sweep goes on; the run then ends non-zero.
+//! Sweeps: one scene, several operating points (`[sweep]` lists of Ue, lambda, SRR).
+//!
+//! - Without an accuracy target ([`run`]) the mesh and the condensed elastic block are
+//!   built once; each point starts from the previous converged state (and from the Hertz
+//!   start when that fails).
+//! - With `accuracy.target` ([`run_adaptive`]) every point is refined adaptively by itself,
+//!   as a single-point scene would be: the film's thin features move with the operating
+//!   point (the side lobes and the outlet with the speed, the spin pole with the tilt), so
+//!   one mesh cannot hold a target across a sweep. Each point has its own levels, estimate
+//!   and time budget.
+//!
+//! A point that fails is recorded with its reason and the sweep goes on; the run then ends
+//! non-zero (exit 4 when every point has a result but some are short of the target).
 //!
 //! Output: `point_NNN/` per converged point (summary.json, profiles, plots, as for a single
 //! scene), `sweep.csv` (rewritten after every point, so a long sweep can be watched) and
 //! PNG plots of the film and the friction against the swept parameters.
+use super::adapt::Adapted;
+use super::estimate::Estimate;
 use super::lubricated::{post_point, PointResult, Setup};
-use super::{collective, Context};
+use super::{collective, Context, Outcome};
 use crate::case::Scene;
 use crate::ehl::driver::EhlSolver;
 use crate::error::Error;
 use crate::output::plot::{line_plot, LineOpts, Series, Style};
+use mpi::traits::Communicator;
 use std::time::Instant;
 
 /// One row of the sweep table.
@@ -24,6 +36,41 @@ pub struct SweepRow {
     pub result: Result<PointResult, Error>,
     pub newton_iterations: usize,
     pub wall_s: f64,
+    /// A point refined to an accuracy target: whether it reached it, its estimate, levels
+    /// and last level's unknowns.
+    pub adaptive: Option<AdaptiveRow>,
+}
+
+impl SweepRow {
+    fn of(p: &Scene, result: Result<PointResult, Error>, newton_iterations: usize, wall_s: f64, adaptive: Option<AdaptiveRow>) -> SweepRow {
+        SweepRow {
+            ue: p.operating.entrainment_speed.unwrap_or(f64::NAN),
+            lambda_deg: p.operating.tilt_angle,
+            srr: p.operating.slide_to_roll,
+            result,
+            newton_iterations,
+            wall_s,
+            adaptive,
+        }
+    }
+}
+
+/// Adds a point's row and rewrites `sweep.csv` (rank 0), so a long sweep can be watched.
+fn record(ctx: &Context, rows: &mut Vec<SweepRow>, row: SweepRow) -> Result<(), Error> {
+    rows.push(row);
+    if ctx.rank == 0 {
+        write_table(ctx, rows)?;
+    }
+    Ok(())
+}
+
+/// What an adaptively refined sweep point reports in `sweep.csv`.
+#[derive(Debug, Clone)]
+pub struct AdaptiveRow {
+    pub reached: bool,
+    pub estimate: Option<Estimate>,
+    pub levels: usize,
+    pub unknowns: usize,
 }
 
 fn point_label(p: &Scene) -> String {
@@ -81,27 +128,72 @@ pub fn run<'a>(ctx: &'a Context, scene: &Scene, setup: &Setup, solver: &EhlSolve
                 }
             }
         }
-        rows.push(SweepRow {
-            ue: p.operating.entrainment_speed.unwrap_or(f64::NAN),
-            lambda_deg: p.operating.tilt_angle,
-            srr: p.operating.slide_to_roll,
-            result,
-            newton_iterations: its,
-            wall_s,
-        });
-        if ctx.rank == 0 {
-            write_table(ctx, &rows)?;
+        record(ctx, &mut rows, SweepRow::of(p, result, its, wall_s, None))?;
+    }
+    finish(ctx, scene, &rows).map(|_| ())
+}
+
+/// A sweep with an accuracy target: each point through the adaptive loop
+/// ([`super::adapt::run`]) from the scene's first mesh and the Hertz start, written into its
+/// `point_NNN/` as a single-point run would be. The point's log lines count its own time;
+/// its time budget (`accuracy.max_seconds`) is its own. Collective.
+pub fn run_adaptive(ctx: &Context, scene: &Scene) -> Result<Outcome, Error> {
+    let points = scene.points();
+    let n = points.len();
+    ctx.log(format!("sweep: {n} operating points, each refined adaptively to accuracy.target = {}", scene.accuracy.target));
+    let mut rows: Vec<SweepRow> = Vec::new();
+    for (k, p) in points.iter().enumerate() {
+        crate::interrupt::check("the sweep")?;
+        let t0 = Instant::now();
+        ctx.log(format!("sweep point {} of {}: {}", k + 1, n, point_label(p)));
+        let dir = ctx.out_dir.join(format!("point_{:03}", k + 1));
+        ctx.create_dir(&dir)?;
+        let point_ctx =
+            Context { world: ctx.world.duplicate(), rank: ctx.rank, size: ctx.size, out_dir: dir.clone(), quiet: ctx.quiet, start: t0 };
+        let injected = crate::ehl_options::get().fail_point == Some(k + 1);
+        let adapted =
+            if injected { Err(Error::not_converged("injected failure (-ehl_fail_point)")) } else { super::adapt::run(&point_ctx, p, None) };
+        // A point whose levels outran its own budget without a level to fall back on
+        // failed; the next point has a budget of its own.
+        if crate::interrupt::agreed() == crate::interrupt::DEADLINE {
+            crate::interrupt::clear_deadline();
         }
+        let wall_s = t0.elapsed().as_secs_f64();
+        let (result, its, adaptive) = match adapted {
+            Ok(Adapted { outcome, point, estimate, levels, unknowns, newton_iterations }) => {
+                let reached = matches!(outcome, Outcome::Done);
+                let how = if reached { "reached the target" } else { "SHORT of the target" };
+                ctx.log(format!("sweep point {} of {} {how} ({levels} levels, {unknowns} unknowns, {wall_s:.1} s)", k + 1, n));
+                (Ok(point), newton_iterations, Some(AdaptiveRow { reached, estimate, levels, unknowns }))
+            }
+            Err(e) => {
+                ctx.log(format!("sweep point {} of {} FAILED ({wall_s:.1} s): {e}", k + 1, n));
+                if ctx.rank == 0 {
+                    // Only points with a result keep a folder: no partial output.
+                    let _ = std::fs::remove_dir_all(&dir);
+                }
+                if crate::interrupt::agreed() != 0 {
+                    return Err(e);
+                }
+                (Err(e), 0, None)
+            }
+        };
+        record(ctx, &mut rows, SweepRow::of(p, result, its, wall_s, adaptive))?;
     }
+    finish(ctx, scene, &rows)
+}
+
+/// The end of a sweep: its plots and last log line; an error naming the failed points,
+/// or the points short of their target (exit 4).
+fn finish(ctx: &Context, scene: &Scene, rows: &[SweepRow]) -> Result<Outcome, Error> {
+    let n = rows.len();
     if ctx.rank == 0 && scene.output.png {
-        sweep_plots(ctx, scene, &rows)?;
+        sweep_plots(ctx, scene, rows)?;
     }
-    let failed: Vec<String> = rows
-        .iter()
-        .enumerate()
-        .filter(|(_, r)| r.result.is_err())
-        .map(|(i, r)| format!("point {} ({})", i + 1, format_args!("Ue = {}, lambda = {}, SRR = {}", r.ue, r.lambda_deg, r.srr)))
-        .collect();
+    let label = |i: usize, r: &SweepRow| format!("point {} (Ue = {}, lambda = {}, SRR = {})", i + 1, r.ue, r.lambda_deg, r.srr);
+    let failed: Vec<String> = rows.iter().enumerate().filter(|(_, r)| r.result.is_err()).map(|(i, r)| label(i, r)).collect();
+    let short: Vec<String> =
+        rows.iter().enumerate().filter(|(_, r)| r.adaptive.as_ref().is_some_and(|a| !a.reached)).map(|(i, r)| label(i, r)).collect();
     let total: f64 = rows.iter().map(|r| r.wall_s).sum();
     ctx.log(format!(
         "sweep done: {} of {} points converged, {:.1} s of solves ({:.1} s per point); table {}",
@@ -111,24 +203,54 @@ pub fn run<'a>(ctx: &'a Context, scene: &Scene, setup: &Setup, solver: &EhlSolve
         total / n as f64,
         ctx.out_dir.join("sweep.csv").display()
     ));
-    if failed.is_empty() {
-        Ok(())
-    } else {
-        Err(Error::not_converged(format!("{} of {} sweep points failed: {} (reasons in sweep.csv)", failed.len(), n, failed.join(", "))))
+    if !failed.is_empty() {
+        return Err(Error::not_converged(format!(
+            "{} of {} sweep points failed: {} (reasons in sweep.csv)",
+            failed.len(),
+            n,
+            failed.join(", ")
+        )));
     }
+    if !short.is_empty() {
+        return Ok(Outcome::ShortOfTarget(format!(
+            "{} of {} sweep points short of accuracy.target = {}: {} (their estimates in sweep.csv)",
+            short.len(),
+            n,
+            scene.accuracy.target,
+            short.join(", ")
+        )));
+    }
+    Ok(Outcome::Done)
 }
 
 /// `sweep.csv`: one row per point, in sweep order.
 fn write_table(ctx: &Context, rows: &[SweepRow]) -> Result<(), Error> {
     let mut t = String::from(
-        "point,ue_m_s,tilt_angle_deg,slide_to_roll,status,hc_m,hm_m,pmax_pa,load_error_rel,fx,fz,newton_iterations,wall_s,reason\n",
+        "point,ue_m_s,tilt_angle_deg,slide_to_roll,status,hc_m,hm_m,pmax_pa,load_error_rel,fx,fz,newton_iterations,wall_s,levels,unknowns,est_hc,est_hm,est_fx,est_fz,reason\n",
     );
     let opt = |v: Option<f64>| v.map(|x| format!("{x:e}")).unwrap_or_default();
     for (i, r) in rows.iter().enumerate() {
         let head = format!("{},{},{},{}", i + 1, r.ue, r.lambda_deg, r.srr);
+        // An adaptive point's levels, unknowns and estimated errors (empty on one mesh).
+        let adaptive = match &r.adaptive {
+            Some(a) => {
+                let e = a.estimate;
+                format!(
+                    "{},{},{},{},{},{}",
+                    a.levels,
+                    a.unknowns,
+                    opt(e.map(|e| e.hc)),
+                    opt(e.map(|e| e.hm)),
+                    opt(e.and_then(|e| e.friction).map(|f| f[0])),
+                    opt(e.and_then(|e| e.friction).map(|f| f[1]))
+                )
+            }
+            None => ",,,,,".to_string(),
+        };
+        let status = if r.adaptive.as_ref().is_some_and(|a| !a.reached) { "short_of_target" } else { "converged" };
         match &r.result {
             Ok(p) => t.push_str(&format!(
-                "{head},converged,{:e},{:e},{:e},{:e},{},{},{},{:.2},\n",
+                "{head},{status},{:e},{:e},{:e},{:e},{},{},{},{:.2},{adaptive},\n",
                 p.hc,
                 p.hm,
                 p.pmax,
@@ -139,7 +261,7 @@ fn write_table(ctx: &Context, rows: &[SweepRow]) -> Result<(), Error> {
                 r.wall_s
             )),
             Err(e) => t.push_str(&format!(
-                "{head},failed,,,,,,,{},{:.2},\"{}\"\n",
+                "{head},failed,,,,,,,{},{:.2},{adaptive},\"{}\"\n",
                 r.newton_iterations,
                 r.wall_s,
                 e.to_string().replace('"', "'")

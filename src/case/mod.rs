@@ -124,13 +124,12 @@ pub fn parse_scene_with(text: &str, default_name: &str, overrides: &[String]) ->
         .map_err(|e| SceneErrorKind::Syntax(format!("scene does not match the schema: {e}")))?;
     // A lubricated, elastic, single-point scene whose mesh nobody made by hand is refined
     // to the default target when it gives none; refined adaptively (its own target or the
-    // default) it also gets the adaptive mesh defaults (docs/accuracy.md).
-    let refinable = !hand_mesh
-        && scene.effects.lubrication == LubricationModel::Reynolds
-        && scene.effects.elasticity == ElasticityModel::Elastic
-        && scene.sweep.is_none();
+    // default; a sweep only with its own, since every point is then refined by itself) it
+    // also gets the adaptive mesh defaults (docs/accuracy.md).
+    let refinable =
+        !hand_mesh && scene.effects.lubrication == LubricationModel::Reynolds && scene.effects.elasticity == ElasticityModel::Elastic;
     if scene.accuracy.target < 0.0 {
-        scene.accuracy.target = if refinable { schema::DEFAULT_ACCURACY_TARGET } else { 0.0 };
+        scene.accuracy.target = if refinable && scene.sweep.is_none() { schema::DEFAULT_ACCURACY_TARGET } else { 0.0 };
     }
     if refinable && scene.accuracy.target > 0.0 {
         scene.mesh.growth = schema::ADAPTIVE_GROWTH;
@@ -336,8 +335,6 @@ impl Scene {
                 Some("a dry scene has no film to refine for")
             } else if e.elasticity != ElasticityModel::Elastic {
                 Some("adaptive refinement needs the elastic solid (effects.elasticity = \"elastic\")")
-            } else if self.sweep.is_some() {
-                Some("a sweep solves every point on one mesh: give [mesh] instead")
             } else {
                 None
             };

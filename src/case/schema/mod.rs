@@ -183,7 +183,7 @@ pub const SCENE_FIELDS: &[Field] = &[
     ),
     f!(
         "sweep",
-        "parameter sweep: lists of operating values, one converged solve per combination (entrainment speed outermost, slide-to-roll innermost), each started from the previous converged state",
+        "parameter sweep: lists of operating values, one converged solve per combination (entrainment speed outermost, slide-to-roll innermost), each started from the previous converged state on one mesh; with accuracy.target each point refined adaptively by itself",
         "",
         Kind::Table(SWEEP_FIELDS),
         Presence::Default("none (one operating point)")
@@ -193,7 +193,7 @@ pub const SCENE_FIELDS: &[Field] = &[
         "accuracy target: adaptive refinement of the contact face until the estimated errors are below it",
         "",
         Kind::Table(ACCURACY_FIELDS),
-        Presence::Default("target 0.01 for a lubricated scene without [mesh]; none otherwise")
+        Presence::Default("target 0.01 for a lubricated single-point scene without [mesh]; none otherwise (a sweep refines only with a target of its own)")
     ),
     f!(
         "checks",
