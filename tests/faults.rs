@@ -29,8 +29,13 @@ enum Target {
 fn interrupt_run(name: &str, wait_for: &str, sig: i32, target: Target) -> (Option<i32>, String, std::path::PathBuf) {
     let out = scratch(name).join("out");
     let scene = repo().join("cases/paper/table2-ue2.toml");
+    interrupt(&[scene.to_str().unwrap()], &out, wait_for, sig, target)
+}
+
+/// As [`interrupt_run`], for the program's arguments `args` (with `--output out`).
+fn interrupt(args: &[&str], out: &Path, wait_for: &str, sig: i32, target: Target) -> (Option<i32>, String, std::path::PathBuf) {
     let mut cmd = Command::new("mpirun");
-    cmd.args(["-n", "2"]).arg(binary()).arg(&scene).arg("--output").arg(&out);
+    cmd.args(["-n", "2"]).arg(binary()).args(args).arg("--output").arg(out);
     cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
@@ -69,7 +74,7 @@ fn interrupt_run(name: &str, wait_for: &str, sig: i32, target: Target) -> (Optio
     }
     lines.for_each(drop);
     let output = child.wait_with_output().unwrap();
-    (output.status.code(), String::from_utf8_lossy(&output.stderr).into_owned(), out)
+    (output.status.code(), String::from_utf8_lossy(&output.stderr).into_owned(), out.to_path_buf())
 }
 
 /// Names of the files in `dir` (none if it does not exist).
@@ -104,6 +109,26 @@ fn sigterm_to_every_rank_during_newton_stops_cleanly() {
     assert!(stderr.contains("no result of this solve was written"), "{stderr}");
     assert_eq!(stderr.matches("ehl-petsc: error").count(), 1, "one message, printed once: {stderr}");
     assert_no_results(&out);
+}
+
+#[test]
+fn sigterm_during_a_sweep_with_a_target_keeps_the_finished_points_only() {
+    // Every point of a sweep with a target is an adaptive run of its own: a signal in the
+    // second stops both ranks, the first keeps its folder and its row of sweep.csv, and
+    // nothing of the second is left (its folder appears only with its results).
+    let dir = scratch("fault-sigterm-adaptive-sweep");
+    let text_of = std::fs::read_to_string(repo().join("cases/references/moes-m10-l6.toml")).unwrap();
+    let scene = write_scene(&dir, "sweep.toml", &format!("{text_of}\n[sweep]\nentrainment_speed = [2.0, 4.0]\n"));
+    let args = [scene.as_str(), "--set", "accuracy.target=0.05", "--set", "mesh.contact_size=0.5", "--set", "output.png=false"];
+    let (code, stderr, out) = interrupt(&args, &dir.join("out"), "sweep point 2 of 2", libc::SIGTERM, Target::AllRanks);
+    assert_ne!(code, Some(0), "{stderr}");
+    assert!(stderr.contains("interrupted by SIGTERM"), "{stderr}");
+    let mut files = files_in(&out);
+    files.sort();
+    assert_eq!(files, ["point_001", "sweep.csv"], "{stderr}");
+    assert!(out.join("point_001/summary.json").exists());
+    let table = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    assert_eq!(table.lines().count(), 2, "the header and the first point: {table}");
 }
 
 #[test]

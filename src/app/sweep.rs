@@ -146,8 +146,8 @@ pub fn run_adaptive(ctx: &Context, scene: &Scene) -> Result<Outcome, Error> {
         crate::interrupt::check("the sweep")?;
         let t0 = Instant::now();
         ctx.log(format!("sweep point {} of {}: {}", k + 1, n, point_label(p)));
+        // The point's folder appears with its results (through the staging folder).
         let dir = ctx.out_dir.join(format!("point_{:03}", k + 1));
-        ctx.create_dir(&dir)?;
         let point_ctx =
             Context { world: ctx.world.duplicate(), rank: ctx.rank, size: ctx.size, out_dir: dir.clone(), quiet: ctx.quiet, start: t0 };
         let injected = crate::ehl_options::get().fail_point == Some(k + 1);
