@@ -249,10 +249,11 @@ pub const DEFAULT_MARKING: f64 = 0.9;
 /// hm estimate from 1.35 % to 0.17 %; with the full-rank LU the same memory held 600,000.
 pub const DEFAULT_MAX_UNKNOWNS: u64 = 800_000;
 
-/// Default of `accuracy.max_seconds`: one hour, about 2.5 times the slowest Moes point that
-/// reaches 0.01 on 2 ranks when the machine is idle (M = 1000, L = 20: 1,361 s) and three
-/// times M = 1000, L = 10 (1,068 s), which spent half an hour next to two other jobs and
-/// ended at the former budget of 1800 s. It still ends, with a labelled result, the runs
+/// Default of `accuracy.max_seconds`: one hour, about 2.5 times the longest run measured at
+/// the default target on 2 ranks (cases/hard/heavy-3gpa, 1,325 s) and three to five times the
+/// slowest Moes points (M = 700, L = 7: 1,220 s; M = 1000, L = 20: 778 s), so that a slower or
+/// busier machine still ends them; a former budget of 1800 s was spent, next to two other
+/// jobs, in M = 1000, L = 10's last level. It still ends, with a labelled result, the runs
 /// whose fine levels Newton cannot take (hours of continuation otherwise), and a level the
 /// time left cannot hold is not begun (docs/accuracy.md).
 pub const DEFAULT_MAX_SECONDS: f64 = 3600.0;
