@@ -109,8 +109,7 @@ fn a_target_is_refused_where_it_cannot_apply() {
 #[test]
 fn a_sweep_with_a_target_refines_every_point() {
     let dir = scratch("accuracy_sweep");
-    let text_of = std::fs::read_to_string(repo().join("cases/references/moes-m10-l6.toml")).unwrap();
-    let scene = write_scene(&dir, "sweep.toml", &format!("{text_of}\n[sweep]\nentrainment_speed = [2.0, 4.0]\n"));
+    let scene = moes_m10_speed_sweep(&dir);
     let run = dir.join("run");
     let out = mpirun(
         2,

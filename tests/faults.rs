@@ -117,8 +117,7 @@ fn sigterm_during_a_sweep_with_a_target_keeps_the_finished_points_only() {
     // second stops both ranks, the first keeps its folder and its row of sweep.csv, and
     // nothing of the second is left (its folder appears only with its results).
     let dir = scratch("fault-sigterm-adaptive-sweep");
-    let text_of = std::fs::read_to_string(repo().join("cases/references/moes-m10-l6.toml")).unwrap();
-    let scene = write_scene(&dir, "sweep.toml", &format!("{text_of}\n[sweep]\nentrainment_speed = [2.0, 4.0]\n"));
+    let scene = moes_m10_speed_sweep(&dir);
     let args = [scene.as_str(), "--set", "accuracy.target=0.05", "--set", "mesh.contact_size=0.5", "--set", "output.png=false"];
     let (code, stderr, out) = interrupt(&args, &dir.join("out"), "sweep point 2 of 2", libc::SIGTERM, Target::AllRanks);
     assert_ne!(code, Some(0), "{stderr}");

@@ -88,6 +88,13 @@ pub struct Level {
     pub halvings: u32,
 }
 
+impl Level {
+    /// The level's unknowns: elastic, pressure and H0.
+    pub fn unknowns(&self) -> usize {
+        self.elastic_unknowns + self.pressure_unknowns + 1
+    }
+}
+
 /// A level cut to a budget: it refined the `count` marked triangles of largest indicator,
 /// which carry `share` of the marked indicator, because all of them would have exceeded
 /// the budget `by`.
@@ -216,7 +223,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             // The level is cut to the budget: the marked triangles of largest indicator that
             // fit, once per run (a cut level is the last, below), and not when even the next
             // full level's change could not take every estimate below the target.
-            let before = levels.last().map_or(0, |l| (l.elastic_unknowns + l.pressure_unknowns + 1) as u64);
+            let before = levels.last().map_or(0, |l| l.unknowns() as u64);
             let over_what = match by_time {
                 Some(t) => format!(
                     "level {k} would have {n} unknowns and take about {:.0} s at level {}'s cost ({} unknowns in {:.0} s), more than the {:.0} s left of accuracy.max_seconds = {} s",
@@ -627,7 +634,7 @@ fn time_left(ctx: &Context, acc: crate::case::schema::Accuracy, levels: &[Level]
     // Each rank has its own clock: rank 0's times decide for all, or the ranks could part
     // ways over a level that fits on one and not on another.
     let t = collective::from_rank0(&ctx.world, &[ctx.start.elapsed().as_secs_f64(), last.seconds - last.failed_seconds]);
-    Some(TimeLeft { left: acc.max_seconds - t[0], before: (last.elastic_unknowns + last.pressure_unknowns + 1) as u64, seconds: t[1] })
+    Some(TimeLeft { left: acc.max_seconds - t[0], before: last.unknowns() as u64, seconds: t[1] })
 }
 
 /// After level `k` stopped with `e`: when the time budget was spent (and a level converged
@@ -700,7 +707,7 @@ fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Le
         point,
         estimate: last.est,
         levels: levels.len(),
-        unknowns: last.elastic_unknowns + last.pressure_unknowns + 1,
+        unknowns: last.unknowns(),
         newton_iterations: levels.iter().map(|l| l.newton_iterations).sum(),
     })
 }

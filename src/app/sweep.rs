@@ -53,6 +53,11 @@ impl SweepRow {
             adaptive,
         }
     }
+
+    /// A point refined to a target that ended short of it (`short_of_target` in sweep.csv).
+    fn short_of_target(&self) -> bool {
+        self.adaptive.as_ref().is_some_and(|a| !a.reached)
+    }
 }
 
 /// Adds a point's row and rewrites `sweep.csv` (rank 0), so a long sweep can be watched.
@@ -192,8 +197,7 @@ fn finish(ctx: &Context, scene: &Scene, rows: &[SweepRow]) -> Result<Outcome, Er
     }
     let label = |i: usize, r: &SweepRow| format!("point {} (Ue = {}, lambda = {}, SRR = {})", i + 1, r.ue, r.lambda_deg, r.srr);
     let failed: Vec<String> = rows.iter().enumerate().filter(|(_, r)| r.result.is_err()).map(|(i, r)| label(i, r)).collect();
-    let short: Vec<String> =
-        rows.iter().enumerate().filter(|(_, r)| r.adaptive.as_ref().is_some_and(|a| !a.reached)).map(|(i, r)| label(i, r)).collect();
+    let short: Vec<String> = rows.iter().enumerate().filter(|(_, r)| r.short_of_target()).map(|(i, r)| label(i, r)).collect();
     let total: f64 = rows.iter().map(|r| r.wall_s).sum();
     ctx.log(format!(
         "sweep done: {} of {} points converged, {:.1} s of solves ({:.1} s per point); table {}",
@@ -247,7 +251,7 @@ fn write_table(ctx: &Context, rows: &[SweepRow]) -> Result<(), Error> {
             }
             None => ",,,,,".to_string(),
         };
-        let status = if r.adaptive.as_ref().is_some_and(|a| !a.reached) { "short_of_target" } else { "converged" };
+        let status = if r.short_of_target() { "short_of_target" } else { "converged" };
         match &r.result {
             Ok(p) => t.push_str(&format!(
                 "{head},{status},{:e},{:e},{:e},{:e},{},{},{},{:.2},{adaptive},\n",

@@ -95,6 +95,13 @@ pub fn write_scene(dir: &Path, name: &str, text: &str) -> String {
     p.to_string_lossy().into_owned()
 }
 
+/// Writes into `dir` the M = 10, L = 6 reference scene (cases/references) as a sweep over
+/// Ue = 2 and 4 m/s, and returns its path.
+pub fn moes_m10_speed_sweep(dir: &Path) -> String {
+    let text = std::fs::read_to_string(repo().join("cases/references/moes-m10-l6.toml")).unwrap();
+    write_scene(dir, "sweep.toml", &format!("{text}\n[sweep]\nentrainment_speed = [2.0, 4.0]\n"))
+}
+
 /// A number from a JSON path like "elastic.u2_center_m".
 pub fn num(v: &serde_json::Value, path: &str) -> f64 {
     let mut cur = v;
