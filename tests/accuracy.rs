@@ -234,6 +234,38 @@ fn a_spent_time_budget_writes_the_last_converged_level_and_says_so() {
     assert_eq!(s["film"]["hc_m"], acc["levels"][0]["hc_m"], "{s}");
 }
 
+/// A light, nearly isoviscous point (Moes M = 3, L = 1: the M = 10, L = 6 scene at 0.3 of
+/// its load and 1/6 of its alpha, inlet at X = -4.5, 0.5 a mesh). From the Hertz start the
+/// backtracking line search refuses the first full step and every milder problem's (the
+/// run used to fail there, exit 1); Newton goes on from there with "l2". It must reach the
+/// same discrete solution as Newton with "l2" from the start (`-snes_linesearch_type l2`,
+/// which the user may give): both stop at a residual of 1e-11, so the films agree to
+/// round-off (measured 4e-16); 1e-9 allows for it.
+#[test]
+fn a_light_point_whose_line_search_gives_out_converges_from_the_hertz_start() {
+    let dir = scratch("accuracy_light");
+    let scene = repo().join("cases/references/moes-m10-l6.toml");
+    let solve = |name: &str, extra: &[&str]| {
+        let run = dir.join(name);
+        let mut args = vec![scene.to_str().unwrap(), "--output", run.to_str().unwrap()];
+        for k in ["mesh.contact_size=0.5", "operating.load=9.06", "lubricant.pressure_viscosity=3.4125e-9", "output.png=false"] {
+            args.extend(["--set", k]);
+        }
+        args.extend(extra);
+        let out = mpirun(2, &args);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        (text(&out), summary(&run))
+    };
+    let (log, s) = solve("bt", &[]);
+    assert!(log.contains("the bt line search gave out"), "{log}");
+    let (_, l2) = solve("l2", &["-snes_linesearch_type", "l2"]);
+    assert!((num(&s, "moes.M") - 3.0).abs() < 0.01 && (num(&s, "moes.L") - 1.0).abs() < 0.01, "{}", s["moes"]);
+    for key in ["film.hc_m", "film.hm_m", "pressure.pmax_pa"] {
+        let (a, b) = (num(&s, key), num(&l2, key));
+        assert!((a - b).abs() <= 1e-9 * b.abs(), "{key}: {a} against {b} with l2 from the start");
+    }
+}
+
 /// A first level too coarse for the film is refined and solved again: Table 2 at
 /// Ue = 2 m/s (no `[mesh]` table) from a 1 a grid, where the film closes at (0.5, -0.5) a,
 /// is solved again with the Hertz zone at 0.5 a and the annuli around the radii where the
