@@ -187,6 +187,10 @@ pub struct PressureSummary {
     pub wiggle_x0: Option<f64>,
     #[serde(default)]
     pub wiggle_z0: Option<f64>,
+    /// The centre-line pressure 0.5 a inside the inlet boundary, in p_H: how much of the
+    /// inlet's build-up the domain cuts off (absent in summaries written before it existed).
+    #[serde(default)]
+    pub inlet_over_ph: Option<f64>,
 }
 
 /// Moes' parameters M and L.
