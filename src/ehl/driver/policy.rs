@@ -71,7 +71,8 @@ pub(super) struct Policy {
     /// iterations from residual 8e-2 to 1.3e-2, stopped; with l2, 13 + 7 iterations to
     /// convergence). From the Hertz start "bt": l2 stops there at once on a closed film
     /// (DIVERGED_FUNCTION_DOMAIN: it does not backtrack out of the film's domain), and on
-    /// the Table 2 scenes it costs 0-2 iterations more.
+    /// the Table 2 scenes it costs 0-2 iterations more; a plain Newton whose "bt" gave out
+    /// on an open film goes on with "l2" (`bt_gave_out` in the continuation).
     pub(super) line_search: &'static str,
     /// The MUMPS LU is rebuilt every third Newton step, GMRES solving on it in between
     /// ([`set_newton_linear_solver`]); otherwise an LU at every step (exact Newton). Only
