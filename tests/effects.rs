@@ -50,12 +50,13 @@ fn half_domain_matches_full_domain_with_half_the_unknowns() {
 /// Two dimensional realisations of M = 10, L = 6 (radius 0.08 m against 0.02 m, steel on
 /// steel against two other moduli, eta 0.012 against 0.1 Pa s, Ue 2 against 0.5 m/s) must
 /// give the same dimensionless films H = h/(R sqrt(2U)) and pressure peak P = p/p_H on the
-/// same mesh (lengths in units of a). The two solves start from different films (the
-/// Hamrock-Dowson estimate is not a function of M and L alone) and converge to the same
-/// discrete solution: only Newton's tolerance (1e-11 on nodal pressure corrections in units
-/// of p_H) and round-off separate them (measured: 3e-15). A dimensional constant hidden
-/// anywhere shows far above the bound of 1e-9: the negative-pressure extension of the
-/// Barus law over a fixed 1e7 Pa moved hm by 6e-7 before it became a multiple of 1/alpha.
+/// same mesh (lengths in units of a). One piece of the discrete problem is not similar: the
+/// laws' extension below p = 0 saturates over a fixed 1e7 Pa (`NEGATIVE_PRESSURE_SCALE`, a
+/// numerical device acting only where the penalty lets the pressure go slightly negative),
+/// which moves hm by 6e-7 and pmax by 5e-7 between these two realisations (hc 5e-8; with the
+/// scale made 0.2/alpha the two agree to 3e-15). The bound, 5e-6, holds that; a dimensional
+/// error in the physics (a length in m or a pressure in Pa in the Reynolds, film or elastic
+/// terms) moves the films by per cents.
 #[test]
 fn the_dimensionless_film_depends_only_on_the_moes_parameters() {
     let dir = scratch("effects-similarity");
@@ -109,7 +110,7 @@ fn the_dimensionless_film_depends_only_on_the_moes_parameters() {
         ]
     };
     for ((q, x), (_, y)) in dimensionless(&a, r_a, u2_a).into_iter().zip(dimensionless(&b, r_b, u2_b)) {
-        assert!((x - y).abs() <= 1e-9 * x.abs().max(1.0), "{q}: {x} (R = {r_a} m) against {y} (R = {r_b} m)");
+        assert!((x - y).abs() <= 5e-6 * x.abs().max(1.0), "{q}: {x} (R = {r_a} m) against {y} (R = {r_b} m)");
     }
 }
 
