@@ -87,6 +87,12 @@ fn newton_norms_on(tag: &str, monolithic: bool, ranks: usize) -> Vec<f64> {
         "-snes_max_it",
         "3",
         "-snes_monitor",
+        // The backtracking line search throughout: it only shortens the same Newton step on
+        // both couplings. (Given by the user, it also keeps plain Newton from going on with
+        // "l2" when bt gives out: l2 minimises the norm of the whole residual, whose elastic
+        // rows only the monolithic system has, so its steps differ between the couplings.)
+        "-snes_linesearch_type",
+        "bt",
     ]);
     if monolithic {
         // Exact Newton, as the monolithic coupling takes from the Hertz start by default
