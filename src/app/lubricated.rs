@@ -587,11 +587,6 @@ impl FaceSolution for crate::ehl::post::FieldsOnFace<'_> {
     }
 }
 
-/// The film formulas beside the result (Hamrock-Dowson's `hd`, the Nijenbanning-Venner-Moes
-/// central film `nvm`), each with the result's difference from it: a user comparing with a
-/// formula sees the formula's own spread (docs/validation.md) named, not an error of this
-/// solution. None when the scene has no finite, positive formula film (rigid or isoviscous
-/// solids).
 /// Where the inlet's cut-off is measured: the centre-line pressure this far (units of a)
 /// inside the inlet boundary X = `reynolds.x_min`, in p_H (summary.json's
 /// `pressure.inlet_over_ph`).
@@ -620,6 +615,11 @@ fn inlet_warning(p_inlet: f64, x_min: f64, target: f64) -> Option<String> {
     })
 }
 
+/// The film formulas beside the result (Hamrock-Dowson's `hd`, the Nijenbanning-Venner-Moes
+/// central film `nvm`), each with the result's difference from it: a user comparing with a
+/// formula sees the formula's own spread (docs/validation.md) named, not an error of this
+/// solution. None when the scene has no finite, positive formula film (rigid or isoviscous
+/// solids).
 fn formulas_line(hd: Option<&HamrockDowson>, nvm: Option<f64>, hc: f64, hm: f64) -> Option<String> {
     let ok = |v: f64| v.is_finite() && v > 0.0;
     let hd = hd.filter(|h| ok(h.central_film_thickness()) && ok(h.minimum_film_thickness()))?;

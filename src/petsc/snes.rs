@@ -58,6 +58,9 @@ pub struct SolveReport {
     /// The residual norm at the start (before the first step).
     pub initial_residual_norm: f64,
     pub domain_error: Option<String>,
+    /// The stall test stopped the solve ([`Snes::set_stall_test`]; the reason is then
+    /// DIVERGED_MAX_IT with "stalled" in its text).
+    pub stalled: bool,
 }
 
 /// A PETSc SNES (Newton with line search by default; everything overridable by options).
@@ -280,6 +283,7 @@ impl Snes {
         let mut s: *const std::os::raw::c_char = std::ptr::null();
         pcall!(ffi::SNESGetConvergedReasonString(self.raw, &mut s))?;
         let mut reason_name = if s.is_null() { reason.to_string() } else { unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned() };
+        let stalled = self.stall.as_ref().is_some_and(|t| t.stalled);
         if let Some(t) = self.stall.as_ref().filter(|t| t.stalled) {
             reason_name = format!(
                 "{reason_name}: stalled (the residual norm fell by less than {:.0} % in {} iterations)",
@@ -305,6 +309,7 @@ impl Snes {
             residual_norm: norm,
             initial_residual_norm: initial,
             domain_error: ctx.domain_error.take(),
+            stalled,
         })
     }
 

@@ -45,7 +45,7 @@ const CRAWL: f64 = 0.1;
 /// first step, where "l2" converged in 16 and 13 iterations (and full steps in 18).
 fn bt_gave_out(r: &SolveReport, closed: bool) -> bool {
     let crawled = r.reason_code == petsc::ffi::SNESConvergedReason_SNES_DIVERGED_MAX_IT
-        && !r.reason.contains("stalled")
+        && !r.stalled
         && r.residual_norm < CRAWL * r.initial_residual_norm;
     let refused = r.reason_code == petsc::ffi::SNESConvergedReason_SNES_DIVERGED_LINE_SEARCH && !closed;
     r.domain_error.is_none() && (crawled || refused)
@@ -347,14 +347,27 @@ impl Newton<'_> {
         Ok(r)
     }
 
+    /// [`Newton::solve`] with the line search `ls.0`, the policy's `ls.1` set back after it
+    /// (a user's `-snes_linesearch_type` stays in force throughout).
+    fn solve_with_line_search(
+        &mut self,
+        ls: (&str, &str),
+        sc: &Scene,
+        system: &mut dyn EhlProblem,
+        start: &[f64],
+        short: bool,
+    ) -> Result<SolveReport, Error> {
+        petsc::options::set_ours("-snes_linesearch_type", ls.0)?;
+        let r = self.solve(sc, system, start, short);
+        petsc::options::set_ours("-snes_linesearch_type", ls.1)?;
+        r
+    }
+
     /// Newton again from the last iterate of `failed` (a solve that [`bt_gave_out`]) with the
     /// "l2" line search, which takes the steps "bt" refused; the solve is logged and counted.
     fn on_with_l2(&mut self, sc: &Scene, system: &mut dyn EhlProblem, short: bool, failed: &SolveReport) -> Result<SolveReport, Error> {
         let from = self.solution()?;
-        petsc::options::set_ours("-snes_linesearch_type", "l2")?;
-        let r = self.solve(sc, system, &from, short);
-        petsc::options::set_ours("-snes_linesearch_type", "bt")?;
-        let r = r?;
+        let r = self.solve_with_line_search(("l2", "bt"), sc, system, &from, short)?;
         self.iterations += r.iterations;
         self.note(format!(
             "Newton: the bt line search gave out (residual {:.3e} -> {:.3e} in {} iterations); on from there with l2: {} ({} iterations)",
@@ -397,10 +410,7 @@ impl Newton<'_> {
                 r.reason,
                 r.iterations
             ));
-            petsc::options::set_ours("-snes_linesearch_type", "bt")?;
-            let again = self.solve(&sc, system, start, short);
-            petsc::options::set_ours("-snes_linesearch_type", "l2")?;
-            r = again?;
+            r = self.solve_with_line_search(("bt", "l2"), &sc, system, start, short)?;
         }
         self.iterations += r.iterations;
         self.note(format!("{} continuation: {what}{}: {} ({} iterations)", p.name(), p.show(t), r.reason, r.iterations));
@@ -724,6 +734,7 @@ mod tests {
     fn report(code: i32, reason: &str, initial: f64, last: f64, domain: bool) -> SolveReport {
         SolveReport {
             converged: false,
+            stalled: reason.contains("stalled"),
             reason: reason.into(),
             reason_code: code,
             iterations: 30,
