@@ -366,6 +366,21 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         tried_s += t0.elapsed().as_secs_f64();
                         continue;
                     }
+                    // A film that closes next to a spin pole inside the Hertz circle closes on
+                    // every finer mesh: the coarser level converged only because its elements
+                    // do not resolve the pole, so its film is no result (no retry, nothing
+                    // written). The full ladder after such a failure spent 500 s and more
+                    // closing the film at the same node (docs/hard-cases.md, "Strong spin").
+                    Err(e) if crate::interrupt::agreed() == 0 && at_spin_pole(ctx, &e) => {
+                        drop(solver);
+                        return Err(Error::Context {
+                            context: format!(
+                                "accuracy: level {k} (level {} converged on its coarser mesh only, which does not resolve the spin pole; no result written)",
+                                k - 1
+                            ),
+                            source: Box::new(e),
+                        });
+                    }
                     Err(e) if crate::interrupt::agreed() == 0 && !last_resorts => {
                         ctx.log(format!(
                             "accuracy: level {k} did not converge ({}); again on the same mesh with the load and speed continuations and the Hertz start",
@@ -609,11 +624,24 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
 /// fault), and not a film closing at a spin pole (which closes on any mesh): the failures
 /// after which a level is solved again. Collective.
 fn newton_failed(ctx: &Context, e: &Error) -> bool {
-    collective::all(
-        &ctx.world,
-        matches!(e.root(), Error::NotConverged { .. } | Error::FilmClosed { .. })
-            && !e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE),
-    )
+    collective::all(&ctx.world, newton_failure(e) && !closed_at_spin_pole(e))
+}
+
+/// Whether Newton failed on every rank because the film closed next to a spin pole inside
+/// the Hertz circle, where the model has no film on any mesh. Collective.
+fn at_spin_pole(ctx: &Context, e: &Error) -> bool {
+    collective::all(&ctx.world, closed_at_spin_pole(e))
+}
+
+/// Whether `e` is Newton's own failure (not converged, or the film closed on the way).
+fn newton_failure(e: &Error) -> bool {
+    matches!(e.root(), Error::NotConverged { .. } | Error::FilmClosed { .. })
+}
+
+/// Whether `e` is Newton's failure with the film closed next to a spin pole inside the
+/// Hertz circle (the driver's diagnosis, in its message).
+fn closed_at_spin_pole(e: &Error) -> bool {
+    newton_failure(e) && e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE)
 }
 
 /// Why `e` stopped Newton, without the path of solves it lists, for the log.
@@ -748,4 +776,29 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
         report["not_reached_because"] = json!(why);
     }
     report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ehl::driver::POLE_COLLAPSE;
+
+    fn closed(message: String) -> Error {
+        Error::FilmClosed { message, closed: vec![[0.0, -0.75]], reached: None }
+    }
+
+    #[test]
+    fn only_newtons_failure_at_a_spin_pole_stops_the_refinement() {
+        // The driver's diagnosis of a film closed next to a pole inside the Hertz circle,
+        // bare and as a level's context adds it.
+        let pole = closed(format!("film closed at (0.000, -0.750)a; the film closes at (0.000, -0.750)a, {POLE_COLLAPSE} (0, -0.633)a"));
+        assert!(closed_at_spin_pole(&pole) && newton_failure(&pole));
+        let wrapped = Error::Context { context: "level 1".into(), source: Box::new(pole) };
+        assert!(closed_at_spin_pole(&wrapped));
+        // A film closed at a side lobe is refined and solved again.
+        let lobe = closed("film closed at (0.250, -0.875)a after 7 iterations".into());
+        assert!(newton_failure(&lobe) && !closed_at_spin_pole(&lobe));
+        // Words alone are not Newton's failure.
+        assert!(!closed_at_spin_pole(&Error::Numerical(format!("{POLE_COLLAPSE} (0, -0.6)a"))));
+    }
 }
