@@ -180,7 +180,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     // output folder only when complete and not interrupted.
     let exponents = super::sensitivity::of_state(ctx, scene, &solver, &setup.mesh, &setup.layout, &sol.x);
     ctx.write_results(|dir| {
-        post_point(ctx, scene, &setup, &sol, solver.condensation_s, dir)?;
+        post_point(ctx, scene, &setup, &sol, solver.condensation_s, None, dir)?;
         super::sensitivity::add_to_summary(ctx, dir, exponents.as_ref()).map(|()| Outcome::Done)
     })
 }
@@ -217,6 +217,7 @@ pub fn post_point(
     setup: &Setup,
     sol: &EhlSolution,
     condensation_s: Option<f64>,
+    friction: Option<FrictionResult>,
     dir: &Path,
 ) -> Result<PointResult, Error> {
     let t_post = Instant::now();
@@ -268,7 +269,10 @@ pub fn post_point(
     let fset = friction_setup(scene, rect);
     let friction = match &fset {
         Some(fs) => {
-            let f = friction_pass(&fields, fs)?;
+            let f = match friction {
+                Some(f) => f,
+                None => friction_pass(&fields, fs)?,
+            };
             ctx.log(format!(
                 "friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s; the rule subdivided on {} of {} triangles, {} stress evaluations)",
                 scene.effects.friction,

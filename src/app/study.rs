@@ -210,7 +210,9 @@ pub fn run(ctx: &Context, scene: &Scene, levels: usize, ladder: Ladder, first: f
             Some(e) => e.solve(ctx, &sc, &solver),
             None => solver.solve(ctx, &sc, None),
         }
-        .and_then(|sol| collective::agree(&ctx.world, post_point(ctx, &sc, &setup, &sol, solver.condensation_s, &dir)).map(|r| (sol, r)));
+        .and_then(|sol| {
+            collective::agree(&ctx.world, post_point(ctx, &sc, &setup, &sol, solver.condensation_s, None, &dir)).map(|r| (sol, r))
+        });
         let rss_mb = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
         let level = match solved {
             Ok((sol, r)) => Level {

@@ -109,7 +109,7 @@ pub fn run<'a>(ctx: &'a Context, scene: &Scene, setup: &Setup, solver: &EhlSolve
                 its = sol.newton_total;
                 let r = collective::agree(
                     &ctx.world,
-                    post_point(ctx, p, setup, &sol, solver.condensation_s.map(|c| if k == 0 { c } else { 0.0 }), &dir),
+                    post_point(ctx, p, setup, &sol, solver.condensation_s.map(|c| if k == 0 { c } else { 0.0 }), None, &dir),
                 );
                 if r.is_ok() {
                     prev = Some(sol.x);

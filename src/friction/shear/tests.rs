@@ -200,6 +200,31 @@ fn collinear_gradient_matches_closed_form() {
     }
 }
 
+/// Test 4b'. Newton's collinear start is that closed form, for any direction and also where
+/// the film's stresses cancel (a = 400: +-200 tau0 across it): the start meets the
+/// criterion, and across the pressure gradient it lies nearer the solution than the
+/// uniform-film start (a thick film under the outlet spike: |a| = 100 at 1 rad from the
+/// slide, b = 1e12).
+#[test]
+fn the_collinear_start_solves_the_collinear_problem() {
+    use super::eyring::{collinear_stress, film_integrals, starting_stress};
+    for (a, b) in [(2.0, 0.3), (-20.0, 1e4), (50.0, -7.0), (400.0, 1e8)] {
+        let angle: f64 = -2.1;
+        let e = [angle.cos(), angle.sin()];
+        let s = collinear_stress([b * e[0], b * e[1]], [a * e[0], a * e[1]]);
+        let s0 = -0.5 * a + (b * a / (2.0 * (0.5 * a).sinh())).asinh();
+        let expected = [s0 * e[0], s0 * e[1]];
+        assert!(dist(s, expected) <= 1e-12 * (1.0 + a.abs()), "a {a}, b {b}: {s:?} vs {expected:?}");
+        let int = film_integrals(s, [a * e[0], a * e[1]]);
+        let r = dist(int.g, [b * e[0], b * e[1]]);
+        assert!(r <= 1e-12 * (b.abs() + int.magnitude), "a {a}, b {b}: residual {r:e}");
+    }
+    let (b, a) = ([1e12, 0.0], [100.0 * 1f64.cos(), 100.0 * 1f64.sin()]);
+    let solution = super::eyring::solve_dimensionless(b, a).unwrap();
+    let (near, far) = (dist(collinear_stress(b, a), solution), dist(starting_stress(b, a), solution));
+    assert!(near < 0.1 * far, "collinear start {near} from the solution, uniform start {far}");
+}
+
 /// Test 4c. Symmetries: t0(-g, -slide) = -t0(g, slide) (tau -> -tau leaves F unchanged),
 /// and rotating (slide, g) by an angle rotates t0 (the law is isotropic).
 #[test]
