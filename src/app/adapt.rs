@@ -374,7 +374,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     // every finer mesh: the coarser level converged only because its elements
                     // do not resolve the pole, so its film is no result (no retry, nothing
                     // written). The full ladder after such a failure spent 500 s and more
-                    // closing the film at the same node (docs/hard-cases.md, "Strong spin").
+                    // closing the film at the same node (docs/accuracy.md, "The loop", step 1).
                     Err(e) if crate::interrupt::agreed() == 0 && at_spin_pole(ctx, &e) => {
                         drop(solver);
                         return Err(Error::Context {
