@@ -40,7 +40,7 @@ use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
 use crate::case::Scene;
 use crate::collective;
-use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, RampLimits, Start};
+use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, RampLimits, Start, Tries};
 use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
 use crate::friction::pass::FrictionResult;
@@ -192,8 +192,19 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     // the meshes tried for it that were over the budget (count, unknowns).
     let mut cut: Option<Cut> = None;
     let mut over: Vec<(usize, u64)> = Vec::new();
+    // The present level was made by quartering and its plain Newton failed: it is meshed
+    // again with the quartered triangles halved.
+    let mut halve_quartered = false;
     loop {
         let scene = &own;
+        if std::mem::take(&mut halve_quartered) {
+            if let Some(prev) = previous.as_mut() {
+                if let Some(m) = prev.marking.as_mut() {
+                    m.quarter = false;
+                    next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), m, None, growth));
+                }
+            }
+        }
         // The level being solved: one per converged level (a retried first level stays 0).
         let k = levels.len();
         let t0 = Instant::now();
@@ -301,7 +312,17 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 // L = 20 those cost 330 s on level 3 and never converged from a coarser
                 // level's pressure. A failure the raise does not answer gets them after all.
                 let raisable = scene.reynolds.gradient_jump > 0.0 && scene.reynolds.gradient_jump < RAISED_GRADIENT_JUMP;
-                let last_resorts = !raisable || full_ladder == Some(k);
+                // A level made by quartering tries plain Newton alone: if that fails it is
+                // meshed again halved (below), which converged by plain Newton where the
+                // quartered level needed the continuation and the raise (a traction drive at
+                // L = 22: 62 s to a tighter target against 638 s, docs/practice.md).
+                let quartered = next.as_ref().is_some_and(|m| m.halvings == 2) && raised_from.is_none() && full_ladder != Some(k);
+                let tries = match (plain, quartered) {
+                    (false, _) => Tries::Continuation,
+                    (true, true) => Tries::Plain,
+                    (true, false) => Tries::PlainThenContinuation,
+                };
+                let last_resorts = (!raisable || full_ladder == Some(k)) && tries != Tries::Plain;
                 // A monolithic level after a monolithic one starts from its displacement.
                 let coarser = (prev.sol.coupling == Coupling::Monolithic).then_some(Coarser {
                     mesh: &prev.setup.mesh,
@@ -321,7 +342,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     (false, true) => RampLimits::PATIENT,
                     (false, false) => RampLimits::DEFAULT,
                 };
-                let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, plain, milder, last_resorts, ramp, coarser };
+                let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, tries, milder, last_resorts, ramp, coarser };
                 // After the raise: first from the failed try's furthest state (its milder
                 // problem, on this same mesh), without the last resorts; if that fails, from
                 // the coarser level's state as before. At M = 1000, L = 20 the try with
@@ -341,6 +362,17 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 let solved = collective::agree(&ctx.world, solved);
                 match solved {
                     Ok(sol) => sol,
+                    Err(e) if crate::interrupt::agreed() == 0 && tries == Tries::Plain && newton_failed(ctx, &e) => {
+                        ctx.log(format!(
+                            "accuracy: level {k} did not converge by plain Newton on its quartered mesh ({}); again with its {} quartered triangles halved",
+                            reason(&e),
+                            prev.marking.as_ref().map_or(0, |m| m.quartered())
+                        ));
+                        halve_quartered = true;
+                        drop(solver);
+                        tried_s += t0.elapsed().as_secs_f64();
+                        continue;
+                    }
                     // A level that does not converge with a small gradient-jump factor is
                     // solved again on the same mesh with it raised, for it and the levels
                     // after: at M = 100, L = 20 the outlet spike is one element wide on the

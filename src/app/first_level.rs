@@ -7,7 +7,7 @@ use super::marking::{field_of_sizes, longest_edges, next_field, within_bands, wi
 use super::Context;
 use crate::case::Scene;
 use crate::collective;
-use crate::ehl::driver::{Coarser, EhlSolution, EhlSolver, Milder, RampLimits, Start};
+use crate::ehl::driver::{Coarser, EhlSolution, EhlSolver, Milder, RampLimits, Start, Tries};
 use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
 use crate::mesh::size_field::SizeField;
@@ -176,6 +176,6 @@ pub(super) fn from_reached<'a>(
     solver.solve_from(
         ctx,
         scene,
-        Start::Pressure { p: &p, hc, label, plain: false, milder: Some(milder), last_resorts: false, ramp, coarser },
+        Start::Pressure { p: &p, hc, label, tries: Tries::Continuation, milder: Some(milder), last_resorts: false, ramp, coarser },
     )
 }

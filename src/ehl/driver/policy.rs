@@ -1,6 +1,6 @@
 //! The solver-option policy: which coupling a scene gets, and the PETSc options (Newton,
 //! line search, linear solver) each solve sets as overridable defaults.
-use super::start::Start;
+use super::start::{Start, Tries};
 use crate::case::Scene;
 use crate::petsc;
 
@@ -163,7 +163,7 @@ impl Attempt {
     ///   pressure converged in 9 + 11 + 7 iterations; the Hertz start on a fine level
     ///   redoes the whole ramp from far away and stalls short of the scene's alpha
     ///   (M = 100, L = 20).
-    /// - A coarser level that itself needed the continuation (`plain: false`): the
+    /// - A coarser level that itself needed the continuation ([`Tries::Continuation`]): the
     ///   continuation at once. Plain Newton failed on every level after the first at
     ///   M = 1000, L = 10 and M = 100, L = 20 (levels 1-3), and on the 449k-unknown level it
     ///   cost 540 s before the continuation started. Its milder problem starts from the
@@ -175,8 +175,9 @@ impl Attempt {
             Start::Hertz => vec![Attempt::PLAIN],
             Start::Previous(_) if monolithic => vec![first, Attempt::PLAIN],
             Start::Previous(_) => vec![first],
-            Start::Pressure { plain: true, .. } => vec![first, Attempt { continues: true, ..first }],
-            Start::Pressure { plain: false, .. } => vec![Attempt { continues: true, ..first }],
+            Start::Pressure { tries: Tries::PlainThenContinuation, .. } => vec![first, Attempt { continues: true, ..first }],
+            Start::Pressure { tries: Tries::Plain, .. } => vec![first],
+            Start::Pressure { tries: Tries::Continuation, .. } => vec![Attempt { continues: true, ..first }],
         }
     }
 
@@ -292,7 +293,7 @@ pub fn set_newton_linear_solver(reuse_lu: bool) -> petsc::Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::{Attempt, Policy, Start};
+    use super::{Attempt, Policy, Start, Tries};
 
     #[test]
     fn another_meshs_pressure_continues_from_itself_after_a_short_plain_newton() {
@@ -314,7 +315,7 @@ mod tests {
             p: &p,
             hc: 0.5,
             label: "level 1",
-            plain: false,
+            tries: Tries::Continuation,
             milder: None,
             last_resorts: true,
             ramp: crate::ehl::driver::RampLimits::DEFAULT,
@@ -322,6 +323,19 @@ mod tests {
         };
         assert_eq!(Attempt::ladder(&hard, true), vec![Attempt { reuse_lu: true, continues: true }]);
         assert_eq!(Attempt::ladder(&hard, false), vec![Attempt { reuse_lu: false, continues: true }]);
+        // A quartered level: plain Newton alone (its caller halves the level instead).
+        let quartered = Start::Pressure {
+            p: &p,
+            hc: 0.5,
+            label: "level 3",
+            tries: Tries::Plain,
+            milder: None,
+            last_resorts: false,
+            ramp: crate::ehl::driver::RampLimits::BEFORE_A_REMEDY,
+            coarser: None,
+        };
+        assert_eq!(Attempt::ladder(&quartered, true), vec![Attempt { reuse_lu: true, continues: false }]);
+        assert!(!quartered.last_resorts());
         // A sweep's previous point: the LU reuse on the monolithic coupling, then exact Newton.
         let x = [0.0; 4];
         assert_eq!(Attempt::ladder(&Start::Previous(&x), true).len(), 2);
@@ -334,7 +348,7 @@ mod tests {
             p: &p,
             hc: 0.5,
             label: "level 2",
-            plain: false,
+            tries: Tries::Continuation,
             milder: None,
             last_resorts: false,
             ramp: crate::ehl::driver::RampLimits::DEFAULT,

@@ -23,9 +23,8 @@ pub enum Start<'s> {
     Previous(&'s [f64]),
     /// A pressure field P(X, Z) from another mesh (mesh sequencing: a coarser level's
     /// converged solution, interpolated), its deflection, and H0 so that the central film
-    /// is `hc` (dimensionless). `label` names it in the log. With `plain` false plain
-    /// Newton is skipped and the continuation runs from it at once (the coarser level
-    /// itself needed the continuation: see [`super::policy::Attempt::ladder`]). With
+    /// is `hc` (dimensionless). `label` names it in the log. `tries`: plain Newton and
+    /// then the continuation, plain Newton alone, or the continuation alone ([`Tries`]). With
     /// `last_resorts` false the load and speed continuations and the Hertz start are not
     /// tried after the continuations nearest the scene (tilt, pressure-viscosity) fail:
     /// the caller has a remedy of its own to try first. `ramp`: when a continuation's ramp
@@ -37,12 +36,25 @@ pub enum Start<'s> {
         p: &'s dyn Fn(f64, f64) -> f64,
         hc: f64,
         label: &'s str,
-        plain: bool,
+        tries: Tries,
         milder: Option<Milder<'s>>,
         last_resorts: bool,
         ramp: RampLimits,
         coarser: Option<Coarser<'s>>,
     },
+}
+
+/// What is tried from another mesh's pressure ([`Start::Pressure`]) before the last resorts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tries {
+    /// Plain Newton, then the continuation from the same start.
+    PlainThenContinuation,
+    /// Plain Newton alone: the caller's own remedy costs less than the continuation (a
+    /// level made finer than the one before by quartering is meshed again halved).
+    Plain,
+    /// The continuation at once: the coarser level itself needed it
+    /// ([`super::policy::Attempt::ladder`]).
+    Continuation,
 }
 
 /// When a continuation's ramp gives up: after `failures` failed steps (None: no such
@@ -94,7 +106,16 @@ impl<'s> Start<'s> {
     /// Another mesh's pressure `p` with central film `hc`, named `label`, with no coarser
     /// state: plain Newton first, then every continuation and the Hertz start.
     pub fn from_pressure(p: &'s dyn Fn(f64, f64) -> f64, hc: f64, label: &'s str) -> Start<'s> {
-        Start::Pressure { p, hc, label, plain: true, milder: None, last_resorts: true, ramp: RampLimits::DEFAULT, coarser: None }
+        Start::Pressure {
+            p,
+            hc,
+            label,
+            tries: Tries::PlainThenContinuation,
+            milder: None,
+            last_resorts: true,
+            ramp: RampLimits::DEFAULT,
+            coarser: None,
+        }
     }
 
     /// The starting pressure P(X, Z) and central film of a start that is not a previous
