@@ -142,6 +142,16 @@ struct Solved {
     friction: Option<FrictionResult>,
 }
 
+impl Solved {
+    /// The next level's mesh from this level's marking with its quartered triangles halved
+    /// (for a level over its budget, or one whose plain Newton failed on the quartered mesh).
+    fn halved_marking(&mut self, growth: f64) -> Option<NextMesh> {
+        let m = self.marking.as_mut()?;
+        m.quarter = false;
+        Some(NextMesh::marked(&self.setup.mesh, &longest_edges(&self.setup.mesh), m, None, growth))
+    }
+}
+
 /// What an adaptive run wrote: its outcome, the last level's numbers and estimate, how many
 /// levels it solved and the unknowns of the last.
 pub struct Adapted {
@@ -198,11 +208,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     loop {
         let scene = &own;
         if std::mem::take(&mut halve_quartered) {
-            if let Some(prev) = previous.as_mut() {
-                if let Some(m) = prev.marking.as_mut() {
-                    m.quarter = false;
-                    next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), m, None, growth));
-                }
+            if let Some(halved) = previous.as_mut().and_then(|p| p.halved_marking(growth)) {
+                next = Some(halved);
             }
         }
         // The level being solved: one per converged level (a retried first level stays 0).
@@ -225,13 +232,11 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // (cases/hard/spin-0.5deg: quartered, level 4 would have had 998,894 unknowns).
         // The marking then halves, here and in a cut below.
         if let Some(prev) = previous.as_mut().filter(|p| n > budget && p.marking.as_ref().is_some_and(|m| m.quartered() > 0)) {
-            let m = prev.marking.as_mut().expect("checked above");
             ctx.log(format!(
                 "accuracy: level {k} would have {n} unknowns, above its budget of {budget}; again with its {} quartered triangles halved",
-                m.quartered()
+                prev.marking.as_ref().map_or(0, |m| m.quartered())
             ));
-            m.quarter = false;
-            next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), m, None, growth));
+            next = prev.halved_marking(growth);
             continue;
         }
         if let (Some(prev), true) = (&previous, n > budget) {

@@ -210,14 +210,15 @@ pub fn friction_setup(scene: &Scene, rect: crate::mesh::Rect) -> Option<Friction
 /// Post-processing of one converged point: film statistics and log line on every rank; on
 /// rank 0 the friction pass and every output file in `dir` (profiles, plots, VTU,
 /// summary.json last). Returns the point's numbers (rank 0; the others return the film
-/// numbers without friction). Not collective except for the peak-memory reduction.
+/// numbers without friction). `computed`: the friction pass already run on this state, if
+/// any (an adaptive level's). Not collective except for the peak-memory reduction.
 pub fn post_point(
     ctx: &Context,
     scene: &Scene,
     setup: &Setup,
     sol: &EhlSolution,
     condensation_s: Option<f64>,
-    friction: Option<FrictionResult>,
+    computed: Option<FrictionResult>,
     dir: &Path,
 ) -> Result<PointResult, Error> {
     let t_post = Instant::now();
@@ -269,7 +270,7 @@ pub fn post_point(
     let fset = friction_setup(scene, rect);
     let friction = match &fset {
         Some(fs) => {
-            let f = match friction {
+            let f = match computed {
                 Some(f) => f,
                 None => friction_pass(&fields, fs)?,
             };

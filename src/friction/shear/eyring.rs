@@ -89,8 +89,9 @@ pub(super) fn collinear_stress(b: [f64; 2], a: [f64; 2]) -> [f64; 2] {
     let e = [a[0] / len, a[1] / len];
     let (along, across) = (dot(b, e), b[1] * e[0] - b[0] * e[1]);
     let half = 0.5 * len;
-    let x = len * along / (2.0 * half.sinh());
-    let sigma = if x.is_finite() && half.sinh().is_finite() {
+    let sinh_half = half.sinh();
+    let x = len * along / (2.0 * sinh_half);
+    let sigma = if x.is_finite() && sinh_half.is_finite() {
         x.asinh() - half
     } else {
         // sinh(|a|/2) overflows: ln|x| = ln(|a| |b.e|) - |a|/2, and asinh of a large x is
