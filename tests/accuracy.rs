@@ -234,23 +234,53 @@ fn a_spent_time_budget_writes_the_last_converged_level_and_says_so() {
     assert_eq!(s["film"]["hc_m"], acc["levels"][0]["hc_m"], "{s}");
 }
 
-/// A light, nearly isoviscous point (Moes M = 3, L = 1: the M = 10, L = 6 scene at 0.3 of
-/// its load and 1/6 of its alpha, inlet at X = -4.5, 0.5 a mesh). From the Hertz start the
-/// backtracking line search refuses the first full step and every milder problem's (the
-/// run used to fail there, exit 1); Newton goes on from there with "l2". It must reach the
-/// same discrete solution as Newton with "l2" from the start (`-snes_linesearch_type l2`,
-/// which the user may give): both stop at a residual of 1e-11, so the films agree to
-/// round-off (measured 4e-16); 1e-9 allows for it.
+/// A steel ball on PDMS (soft EHL: E = 2 MPa, 0.2 N, p_H = 0.1 MPa; M = 32, L = 2e-4). From
+/// the Hertz start with Hamrock-Dowson's piezoviscous film (65 nm, which vanishes with
+/// alpha E') Newton stalled at every start and continuation; from the isoviscous film of
+/// the Nijenbanning-Venner-Moes fit (8.2 um) the "bt" line search crawls (its full steps
+/// refused, the residual falling about 10 % per iteration: at light, nearly isoviscous
+/// points the residual norm rises for a step or two on the way to the solution) and "l2"
+/// finishes from where it stopped. The film must be the one "l2" reaches from the start
+/// (1e-9: the same solution of the same equations) and lie within 20 % of that fit, which
+/// is good to about 10 % at light loads (it lies 9.5 % above an independent multigrid film
+/// at M = 10, L = 6) while the 0.5 a mesh moves hc by about 15 % (0.25 a: -11 %, the
+/// adaptive result -13 %): a unit slip in the soft modulus or the viscosity moves it by
+/// orders of magnitude.
 #[test]
-fn a_light_point_whose_line_search_gives_out_converges_from_the_hertz_start() {
-    let dir = scratch("accuracy_light");
-    let scene = repo().join("cases/references/moes-m10-l6.toml");
+fn a_soft_contact_converges_from_the_isoviscous_film() {
+    let dir = scratch("accuracy_soft");
+    let scene = write_scene(
+        &dir,
+        "pdms.toml",
+        r#"name = "pdms"
+[effects]
+viscosity = "barus"
+density = "incompressible"
+[geometry]
+ball_radius = 0.0127
+[materials.ball]
+young_modulus = 210e9
+poisson_ratio = 0.3
+[materials.disc]
+young_modulus = 2e6
+poisson_ratio = 0.3
+[lubricant]
+viscosity = 0.1
+pressure_viscosity = 2e-9
+[operating]
+load = 0.2
+entrainment_speed = 0.05
+[mesh]
+contact_size = 0.5
+[output]
+png = false
+[checks]
+accept = ["hertz_pressure"]
+"#,
+    );
     let solve = |name: &str, extra: &[&str]| {
         let run = dir.join(name);
-        let mut args = vec![scene.to_str().unwrap(), "--output", run.to_str().unwrap()];
-        for k in ["mesh.contact_size=0.5", "operating.load=9.06", "lubricant.pressure_viscosity=3.4125e-9", "output.png=false"] {
-            args.extend(["--set", k]);
-        }
+        let mut args = vec![scene.as_str(), "--output", run.to_str().unwrap()];
         args.extend(extra);
         let out = mpirun(2, &args);
         assert_eq!(out.status.code(), Some(0), "{}", text(&out));
@@ -259,11 +289,13 @@ fn a_light_point_whose_line_search_gives_out_converges_from_the_hertz_start() {
     let (log, s) = solve("bt", &[]);
     assert!(log.contains("the bt line search gave out"), "{log}");
     let (_, l2) = solve("l2", &["-snes_linesearch_type", "l2"]);
-    assert!((num(&s, "moes.M") - 3.0).abs() < 0.01 && (num(&s, "moes.L") - 1.0).abs() < 0.01, "{}", s["moes"]);
+    assert!((num(&s, "moes.M") - 32.4).abs() < 0.05 && num(&s, "moes.L") < 1e-3, "{}", s["moes"]);
     for key in ["film.hc_m", "film.hm_m", "pressure.pmax_pa"] {
         let (a, b) = (num(&s, key), num(&l2, key));
         assert!((a - b).abs() <= 1e-9 * b.abs(), "{key}: {a} against {b} with l2 from the start");
     }
+    let hc = num(&s, "film.hc_m");
+    assert!((hc / 8.1986e-6 - 1.0).abs() < 0.2, "hc = {hc} m against the isoviscous fit's 8.1986e-6 m");
 }
 
 /// A first level too coarse for the film is refined and solved again: Table 2 at

@@ -622,6 +622,36 @@ impl Scene {
         Some(nijenbanning_central(p.m, p.l) * self.hertz().radius * (2.0 * p.u).sqrt()).filter(|h| h.is_finite() && *h > 0.0)
     }
 
+    /// The central film (m) of the same contact with an isoviscous lubricant: the
+    /// Nijenbanning-Venner-Moes fit at the scene's M and L = 0, for elastic solids. A rise
+    /// of viscosity with pressure only thickens the film, so this is about its lower bound;
+    /// where the lubricant's own pressure-viscosity barely acts (soft solids, light loads)
+    /// it is the film itself, and Hamrock-Dowson's piezoviscous fit, which vanishes with
+    /// alpha, is far below it.
+    pub fn isoviscous_hc(&self) -> Option<f64> {
+        if self.effects.elasticity != ElasticityModel::Elastic {
+            return None;
+        }
+        let l = self.lubricant.as_ref()?;
+        let ue = self.operating.entrainment_speed?;
+        let h = self.hertz();
+        let p = MoesParameters::new(h.load, ue, l.viscosity, 0.0, h.e_prime, h.radius);
+        Some(nijenbanning_central(p.m, 0.0) * h.radius * (2.0 * p.u).sqrt()).filter(|h| h.is_finite() && *h > 0.0)
+    }
+
+    /// The central film (m) expected before solving: Hamrock-Dowson's piezoviscous fit, or
+    /// the isoviscous film ([`Scene::isoviscous_hc`]) where that is thicker. The first is
+    /// the film of a piezoviscous contact and vanishes with alpha E'; the second takes over
+    /// where the viscosity barely rises in the contact (elastic solids only). None without a
+    /// lubricant and speed.
+    pub fn film_estimate(&self) -> Option<f64> {
+        let hd = self.hamrock_dowson().map(|h| h.central_film_thickness()).filter(|h| h.is_finite() && *h > 0.0);
+        match (hd, self.isoviscous_hc()) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
     /// Hamrock-Dowson reference films for this operating point (k = 1), when lubricated.
     pub fn hamrock_dowson(&self) -> Option<HamrockDowson> {
         let l = self.lubricant.as_ref()?;

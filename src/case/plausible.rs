@@ -142,7 +142,7 @@ fn quantities(s: &Scene, memory: Option<f64>) -> Vec<Quantity> {
             value: h.ph,
             hard: (1.0, 5e10),
             soft: (1e6, 4e9),
-            why: "above about 4 GPa steels yield (the model is linear elastic); below 1 MPa (soft EHL: elastomers, gels) the solver is not validated and a steel ball on a 0.12 MPa PDMS contact did not converge",
+            why: "above about 4 GPa steels yield (the model is linear elastic); below 1 MPa a modulus in MPa was more often given as Pa than the contact is soft (soft EHL: elastomers, gels, whose films are checked here only against a curve fit)",
         },
     ];
     let lub = s.effects.lubrication == LubricationModel::Reynolds;
@@ -210,14 +210,11 @@ fn quantities(s: &Scene, memory: Option<f64>) -> Vec<Quantity> {
                 });
             }
         }
-        // The Hamrock-Dowson fit needs a piezoviscous, elastic contact (G > 0): an
-        // isoviscous or rigid scene has no film estimate to check.
-        let piezo_elastic = s.effective_alpha().is_some_and(|a| a > 0.0) && s.effects.elasticity == ElasticityModel::Elastic;
-        if let Some(hd) = s.hamrock_dowson().filter(|_| piezo_elastic) {
-            let hc = hd.central_film_thickness();
+        // A rigid scene's film is not an EHL one: no estimate to check.
+        if let Some(hc) = s.film_estimate().filter(|_| s.effects.elasticity == ElasticityModel::Elastic) {
             q.push(Quantity {
                 name: "film_thickness",
-                what: "Hamrock-Dowson central film estimate (m)".into(),
+                what: "central film estimate (m; Hamrock-Dowson, or the isoviscous film where thicker)".into(),
                 from: "operating.entrainment_speed, lubricant.viscosity, lubricant.pressure_viscosity, operating.load",
                 value: hc,
                 hard: (1e-12, 1e-2),
@@ -436,18 +433,21 @@ mod tests {
     }
 
     /// The quantities of every shipped scene lie inside the soft ranges (the ranges were set
-    /// around them, a decade or more beyond; printed with --nocapture for the docs).
+    /// around them, a decade or more beyond; printed with --nocapture for the docs), except
+    /// the Hertz pressure of cases/practice/soft-pdms.toml, which shows soft EHL below that
+    /// range and accepts it.
     #[test]
     fn shipped_scenes_are_plausible() {
         let mut bad = Vec::new();
         for (name, s) in shipped() {
+            let accepted = if name.ends_with("soft-pdms.toml") { 1 } else { 0 };
             for p in s.check_points() {
                 let line: Vec<String> =
                     quantities(&p, Some(f64::INFINITY)).iter().map(|q| format!("{} {}", q.name, fmt_num(q.value))).collect();
                 eprintln!("{name}: {}", line.join(", "));
             }
             match s.plausibility() {
-                Ok(w) if w.is_empty() => {}
+                Ok(w) if w.len() == accepted && w.iter().all(|m| m.starts_with("Hertz pressure")) => {}
                 Ok(w) => bad.push(format!("{name}: {w:?}")),
                 Err(e) => bad.push(format!("{name}: {e}")),
             }

@@ -40,9 +40,11 @@ const CRAWL: f64 = 0.1;
 /// (DIVERGED_LINE_SEARCH) where the film had not closed. At light, nearly isoviscous
 /// points the residual norm rises for a step or two on the way to the solution, which
 /// bt's sufficient-decrease test does not allow, and every milder problem of the
-/// continuation fails the same way: from the Hertz start (inlet at X = -4.5) Moes M = 5,
-/// L = 2 crawled from 0.72 to 3.5e-2 in 30 iterations and M = 3, L = 1 gave up at its
-/// first step, where "l2" converged in 16 and 13 iterations (and full steps in 18).
+/// continuation fails the same way: from the Hertz start a steel ball on PDMS (M = 32,
+/// L = 2e-4, 0.5 a mesh) crawls from 0.67 to 5.5e-2 in 30 iterations, and "l2" finishes
+/// in 6 more. (With Hamrock-Dowson's film as the start's, Moes M = 5, L = 2 crawled the
+/// same way and M = 3, L = 1 gave up at its first step; from the isoviscous film they
+/// converge by bt.)
 fn bt_gave_out(r: &SolveReport, closed: bool) -> bool {
     let crawled = r.reason_code == petsc::ffi::SNESConvergedReason_SNES_DIVERGED_MAX_IT
         && !r.stalled
