@@ -49,3 +49,17 @@ pub fn from_rank0(world: &SimpleCommunicator, local: &[f64]) -> Vec<f64> {
     root.broadcast_into(&mut out[..]);
     out
 }
+
+/// Every rank's `local` values, concatenated in rank order, on every rank.
+pub fn all_gather_f64(world: &SimpleCommunicator, local: &[f64]) -> Vec<f64> {
+    let size = world.size() as usize;
+    let mut counts = vec![0i32; size];
+    world.all_gather_into(&(local.len() as i32), &mut counts[..]);
+    let displs: Vec<i32> = counts.iter().scan(0, |acc, &n| Some(std::mem::replace(acc, *acc + n))).collect();
+    let mut out = vec![0.0; counts.iter().map(|&n| n as usize).sum()];
+    {
+        let mut part = mpi::datatype::PartitionMut::new(&mut out[..], &counts[..], &displs[..]);
+        world.all_gather_varcount_into(local, &mut part);
+    }
+    out
+}

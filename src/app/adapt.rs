@@ -527,7 +527,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let edges = longest_edges(&setup.mesh);
         let min_size = edges.iter().cloned().fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
         // The pass's adapted rule is kept for the friction goals' gradient below.
-        let friction = level_friction(scene, &fields)?;
+        let friction = level_friction(ctx, scene, &fields)?;
         let level = Level {
             elastic_unknowns: n_u,
             pressure_unknowns: n_p,
@@ -744,11 +744,11 @@ fn describe(est: Option<Estimate>) -> String {
     est.map_or("none: a single level".to_string(), |e| e.describe())
 }
 
-/// The friction pass of a level (every rank holds the whole iterate), or None without
-/// friction.
-fn level_friction(scene: &Scene, fields: &FieldsOnFace) -> Result<Option<FrictionResult>, Error> {
+/// The friction pass of a level, its triangles shared out over the ranks (every rank holds
+/// the whole iterate and gets the whole result; collective), or None without friction.
+fn level_friction(ctx: &Context, scene: &Scene, fields: &FieldsOnFace) -> Result<Option<FrictionResult>, Error> {
     let Some(fs) = super::lubricated::friction_setup(scene, fields.mesh.spec.contact) else { return Ok(None) };
-    crate::friction::pass::friction_pass(fields, &fs).map(Some)
+    crate::friction::pass::friction_pass(fields, &fs, &super::lubricated::OverRanks(ctx)).map(Some)
 }
 
 /// Writes the result of `done` (the last level solved) with the accuracy report; with a

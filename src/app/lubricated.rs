@@ -207,11 +207,23 @@ pub fn friction_setup(scene: &Scene, rect: crate::mesh::Rect) -> Option<Friction
     })
 }
 
-/// Post-processing of one converged point: film statistics and log line on every rank; on
-/// rank 0 the friction pass and every output file in `dir` (profiles, plots, VTU,
-/// summary.json last). Returns the point's numbers (rank 0; the others return the film
+/// The friction pass's triangles shared out over every rank, round robin (collective).
+pub(super) struct OverRanks<'a>(pub(super) &'a Context);
+
+impl crate::friction::pass::Share for OverRanks<'_> {
+    fn mine(&self, k: usize) -> bool {
+        k % self.0.size == self.0.rank
+    }
+    fn gather(&self, local: Result<Vec<f64>, Error>) -> Result<Vec<f64>, Error> {
+        collective::agree(&self.0.world, local).map(|v| collective::all_gather_f64(&self.0.world, &v))
+    }
+}
+
+/// Post-processing of one converged point: film statistics and log line on every rank, the
+/// friction pass shared out over the ranks, and on rank 0 every output file in `dir`
+/// (profiles, plots, VTU, summary.json last). Returns the point's numbers (rank 0; the others return the film
 /// numbers without friction). `computed`: the friction pass already run on this state, if
-/// any (an adaptive level's). Not collective except for the peak-memory reduction.
+/// any (an adaptive level's). Collective: the peak-memory reduction and the friction pass.
 pub fn post_point(
     ctx: &Context,
     scene: &Scene,
@@ -264,16 +276,18 @@ pub fn post_point(
     let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
     let mut res =
         PointResult { hc: st.hc * hs, hm: st.hm * hs, pmax: st.pmax * ph, load_error, fx: None, fz: None, profile_x0: Vec::new() };
+    let fset = friction_setup(scene, rect);
+    // The pass shares its triangles out over the ranks.
+    let computed = match (&fset, computed) {
+        (Some(fs), None) => Some(friction_pass(&fields, fs, &OverRanks(ctx))?),
+        (_, computed) => computed,
+    };
     if ctx.rank != 0 {
         return Ok(res);
     }
-    let fset = friction_setup(scene, rect);
     let friction = match &fset {
-        Some(fs) => {
-            let f = match computed {
-                Some(f) => f,
-                None => friction_pass(&fields, fs)?,
-            };
+        Some(_) => {
+            let f = computed.expect("the pass ran above");
             ctx.log(format!(
                 "friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s; the rule subdivided on {} of {} triangles, {} stress evaluations)",
                 scene.effects.friction,

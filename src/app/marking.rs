@@ -207,7 +207,7 @@ pub(super) fn goals(
     }
     if let Some(f) = friction {
         let setup = super::lubricated::friction_setup(scene, fields.mesh.spec.contact).expect("a scene with friction");
-        let grad = crate::friction::pass::friction_gradient(fields, &setup, &f.rules)?;
+        let grad = crate::friction::pass::friction_gradient(fields, &setup, &f.rules, &super::lubricated::OverRanks(ctx))?;
         let magnitude = f.fx.hypot(f.fz);
         // On a half domain fz vanishes by symmetry, and so does its gradient.
         for (name, c) in [("fx", 0), ("fz", 1)].into_iter().take(if fields.half() { 1 } else { 2 }) {

@@ -39,6 +39,53 @@ pub trait FaceSolution {
     fn locate(&self, x: f64, z: f64) -> Option<(usize, [f64; 3])>;
 }
 
+/// How the pass's triangles are shared out between processes: which ones this process
+/// evaluates, and every process's results gathered on every process. Each triangle's
+/// values are computed by one process and every sum runs in triangle order on every
+/// process, so the result does not depend on how the triangles were shared.
+pub trait Share {
+    /// Whether item `k` (a triangle of the pass, in its order) is this process's.
+    fn mine(&self, k: usize) -> bool;
+    /// Every process's `local` values, concatenated in process order, on every process;
+    /// an error on every process when one of them failed (none is left waiting).
+    fn gather(&self, local: Result<Vec<f64>, Error>) -> Result<Vec<f64>, Error>;
+}
+
+/// Every triangle on this process alone.
+pub struct Alone;
+
+impl Share for Alone {
+    fn mine(&self, _k: usize) -> bool {
+        true
+    }
+    fn gather(&self, local: Result<Vec<f64>, Error>) -> Result<Vec<f64>, Error> {
+        local
+    }
+}
+
+/// `f(k)` for every item k < `n` this process holds, and every item's values on every
+/// process, in item order.
+fn shared(share: &dyn Share, n: usize, mut f: impl FnMut(usize) -> Result<Vec<f64>, Error>) -> Result<Vec<Vec<f64>>, Error> {
+    let mut local = || -> Result<Vec<f64>, Error> {
+        let mut out = Vec::new();
+        for k in (0..n).filter(|&k| share.mine(k)) {
+            let v = f(k)?;
+            out.extend([k as f64, v.len() as f64]);
+            out.extend(v);
+        }
+        Ok(out)
+    };
+    let all = share.gather(local())?;
+    let mut items: Vec<Option<Vec<f64>>> = vec![None; n];
+    let mut i = 0;
+    while i + 1 < all.len() {
+        let (k, len) = (all[i] as usize, all[i + 1] as usize);
+        items[k] = Some(all[i + 2..i + 2 + len].to_vec());
+        i += 2 + len;
+    }
+    items.into_iter().map(|v| v.ok_or_else(|| Error::other("friction pass: a triangle no process evaluated"))).collect()
+}
+
 /// What the pass needs besides the fields: the shear law, the viscosity law, the surface
 /// velocities and the scales that turn the dimensionless fields into SI units.
 pub struct FrictionSetup {
@@ -194,29 +241,44 @@ pub struct FrictionGradient {
 
 /// The derivatives of [`friction_pass`]'s fx and fz with respect to the nodal P and H, by
 /// the chain rule through the P2 interpolation of P, H and grad P at each point of the
-/// pass's adapted rule `rules` (the pass's on the same `fields`), held fixed (serial, the
-/// same on every rank).
-pub fn friction_gradient(fields: &dyn FaceSolution, s: &FrictionSetup, rules: &QuadratureRules) -> Result<FrictionGradient, Error> {
+/// pass's adapted rule `rules` (the pass's on the same `fields`), held fixed; the triangles
+/// shared out by `share`.
+pub fn friction_gradient(
+    fields: &dyn FaceSolution,
+    s: &FrictionSetup,
+    rules: &QuadratureRules,
+    share: &dyn Share,
+) -> Result<FrictionGradient, Error> {
     use crate::fem::p2tri::{p2_tri_basis_bary, p2_tri_grads_bary};
     let mesh = fields.mesh();
-    let mut acc: std::collections::BTreeMap<u32, [f64; 4]> = std::collections::BTreeMap::new();
     // A half domain doubles Fx and cancels Fz (friction_pass).
     let (cx, cz) = if fields.half() { (2.0, 0.0) } else { (1.0, 1.0) };
-    for (t, rule) in &rules.0 {
+    // Each triangle's share: (dfx/dP, dfx/dH, dfz/dP, dfz/dH) at its 6 nodes.
+    let per_triangle = shared(share, rules.0.len(), |k| {
+        let (t, rule) = &rules.0[k];
         let tf = TriFields::new(fields, *t);
         let area = crate::fem::p2tri::tri_area(&tf.v) * s.a * s.a;
-        let nodes = mesh.contact_tris[*t];
+        let mut e = vec![0.0; 24];
         for q in rule {
             let d = tf.inputs(q.l).stress_derivatives(s)?;
             let (n, dn) = (p2_tri_basis_bary(q.l), p2_tri_grads_bary(q.l, &tf.geo.grad_bary));
             let w = q.w * area / s.load;
             for i in 0..6 {
-                let e = acc.entry(nodes[i]).or_insert([0.0; 4]);
                 for (c, scale) in [(0, cx), (1, cz)] {
                     // dtau/dP_i = dtau/dP N_i + dtau/dgrad P . grad N_i; dtau/dH_i = dtau/dH N_i.
-                    e[2 * c] += scale * w * (d[0][c] * n[i] + d[2][c] * dn[i][0] + d[3][c] * dn[i][1]);
-                    e[2 * c + 1] += scale * w * d[1][c] * n[i];
+                    e[4 * i + 2 * c] += scale * w * (d[0][c] * n[i] + d[2][c] * dn[i][0] + d[3][c] * dn[i][1]);
+                    e[4 * i + 2 * c + 1] += scale * w * d[1][c] * n[i];
                 }
+            }
+        }
+        Ok(e)
+    })?;
+    let mut acc: std::collections::BTreeMap<u32, [f64; 4]> = std::collections::BTreeMap::new();
+    for ((t, _), e) in rules.0.iter().zip(&per_triangle) {
+        for (i, &node) in mesh.contact_tris[*t].iter().enumerate() {
+            let a = acc.entry(node).or_insert([0.0; 4]);
+            for c in 0..4 {
+                a[c] += e[4 * i + c];
             }
         }
     }
@@ -346,56 +408,71 @@ impl Adapting<'_> {
 /// by the difference between its rule and its quarters', a sub-triangle's error in turn by
 /// its own quarters). The same rule serves the pass and its gradient, which therefore is
 /// the derivative of the value the pass reports.
-fn adapted_rules(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<AdaptedRules, Error> {
+fn adapted_rules(fields: &dyn FaceSolution, s: &FrictionSetup, share: &dyn Share) -> Result<AdaptedRules, Error> {
     let mesh = fields.mesh();
-    let mut report = QuadratureReport::default();
+    let tris: Vec<usize> = (0..mesh.contact_tris.len()).filter(|&t| in_rect(fields, t, &s.rect)).collect();
+    let area_of = |tf: &TriFields| crate::fem::p2tri::tri_area(&tf.v) * s.a * s.a;
     // The fixed rule on every triangle: the coarse value each adaptation starts from, and
     // the scale of the tolerance.
-    let mut tris = Vec::new();
+    let fixed = shared(share, tris.len(), |k| {
+        let tf = TriFields::new(fields, tris[k]);
+        let mut a = Adapting { tf: &tf, s, area: area_of(&tf), points: Vec::new(), evaluations: 0 };
+        Ok(a.force(&sub_points(&WHOLE, 1.0))?.to_vec())
+    })?;
+    let mut report = QuadratureReport { triangles: tris.len(), evaluations: 12 * tris.len(), ..Default::default() };
     let (mut total, mut area_total, mut absolute) = ([0.0; 2], 0.0, 0.0);
-    for t in (0..mesh.contact_tris.len()).filter(|&t| in_rect(fields, t, &s.rect)) {
-        let tf = TriFields::new(fields, t);
-        let area = crate::fem::p2tri::tri_area(&tf.v) * s.a * s.a;
-        let mut a = Adapting { tf: &tf, s, area, points: Vec::new(), evaluations: 0 };
-        let f = a.force(&sub_points(&WHOLE, 1.0))?;
-        report.evaluations += a.evaluations;
+    for (&t, f) in tris.iter().zip(&fixed) {
         total[0] += f[0];
         total[1] += f[1];
-        area_total += area;
+        area_total += area_of(&TriFields::new(fields, t));
         absolute += f[0].hypot(f[1]);
-        tris.push((t, tf, area, f));
     }
-    report.triangles = tris.len();
     report.fixed = total;
     let scale = total[0].hypot(total[1]).max(CANCELLATION_FLOOR * absolute);
+    // Each triangle's adapted rule: its force, its evaluations, then its points (l, w).
+    let adapted = shared(share, tris.len(), |k| {
+        let tf = TriFields::new(fields, tris[k]);
+        let area = area_of(&tf);
+        let mut a = Adapting { tf: &tf, s, area, points: Vec::new(), evaluations: 0 };
+        let tol = QUADRATURE_TOL * scale * area / area_total;
+        let f = a.take(&WHOLE, 1.0, [fixed[k][0], fixed[k][1]], tol, 0)?;
+        let mut v = vec![f[0], f[1], a.evaluations as f64];
+        v.extend(a.points.iter().flat_map(|q| [q.l[0], q.l[1], q.l[2], q.w]));
+        Ok(v)
+    })?;
     let mut rules = Vec::with_capacity(tris.len());
     let mut force = [0.0; 2];
-    for (t, tf, area, coarse) in &tris {
-        let mut a = Adapting { tf, s, area: *area, points: Vec::new(), evaluations: 0 };
-        let tol = QUADRATURE_TOL * scale * area / area_total;
-        let f = a.take(&WHOLE, 1.0, *coarse, tol, 0)?;
-        force[0] += f[0];
-        force[1] += f[1];
-        report.evaluations += a.evaluations;
-        report.subdivided += usize::from(a.points.len() > 12);
-        rules.push((*t, a.points));
+    for (&t, v) in tris.iter().zip(&adapted) {
+        force[0] += v[0];
+        force[1] += v[1];
+        report.evaluations += v[2] as usize;
+        let points: Vec<RulePoint> = v[3..].chunks_exact(4).map(|q| RulePoint { l: [q[0], q[1], q[2]], w: q[3] }).collect();
+        report.subdivided += usize::from(points.len() > 12);
+        rules.push((t, points));
     }
     Ok(AdaptedRules { rules: QuadratureRules(rules), force, report })
 }
 
-/// Runs the pass over Omega_c (serial; call it on one rank).
-pub fn friction_pass(fields: &dyn FaceSolution, s: &FrictionSetup) -> Result<FrictionResult, Error> {
+/// Runs the pass over Omega_c, the triangles shared out by `share` (collective when the
+/// share spans processes).
+pub fn friction_pass(fields: &dyn FaceSolution, s: &FrictionSetup, share: &dyn Share) -> Result<FrictionResult, Error> {
     let t0 = std::time::Instant::now();
-    let AdaptedRules { rules, force, report: quadrature } = adapted_rules(fields, s)?;
-    let mut tau_max = 0.0f64;
-    let mut nodal = Vec::new();
+    let AdaptedRules { rules, force, report: quadrature } = adapted_rules(fields, s, share)?;
     const NODES: [[f64; 3]; 6] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]];
-    for (t, _) in &rules.0 {
-        let tf = TriFields::new(fields, *t);
-        let mut vals = [[0.0; 2]; 6];
-        for (k, b) in NODES.iter().enumerate() {
-            vals[k] = tf.stress(s, *b)?;
-            tau_max = tau_max.max(vals[k][0].hypot(vals[k][1]));
+    let values = shared(share, rules.0.len(), |k| {
+        let tf = TriFields::new(fields, rules.0[k].0);
+        let mut v = Vec::with_capacity(12);
+        for b in &NODES {
+            v.extend(tf.stress(s, *b)?);
+        }
+        Ok(v)
+    })?;
+    let mut tau_max = 0.0f64;
+    let mut nodal = Vec::with_capacity(rules.0.len());
+    for ((t, _), v) in rules.0.iter().zip(&values) {
+        let vals: [[f64; 2]; 6] = std::array::from_fn(|k| [v[2 * k], v[2 * k + 1]]);
+        for x in &vals {
+            tau_max = tau_max.max(x[0].hypot(x[1]));
         }
         nodal.push((*t, vals));
     }
@@ -512,7 +589,7 @@ mod tests {
         let f = fields();
         let s = steep_setup(Rect { x0: -1.5, x1: 1.5, z0: -1.5, z1: 1.5 });
         let reference = uniform_forces(&f, &s, 4);
-        let AdaptedRules { rules, force: adapted, report } = adapted_rules(&f, &s).unwrap();
+        let AdaptedRules { rules, force: adapted, report } = adapted_rules(&f, &s, &Alone).unwrap();
         let magnitude = reference[0].hypot(reference[1]);
         let off = |v: [f64; 2]| (v[0] - reference[0]).abs().max((v[1] - reference[1]).abs()) / magnitude;
         assert!(off(report.fixed) > 2e-3, "the fixed rule is off by {:.2e} only", off(report.fixed));
@@ -532,9 +609,42 @@ mod tests {
         let f = fields();
         let mut s = steep_setup(Rect { x0: -1.5, x1: 1.5, z0: -1.5, z1: 1.5 });
         s.eta = Box::new(|_| 0.01);
-        let AdaptedRules { force: adapted, report, .. } = adapted_rules(&f, &s).unwrap();
+        let AdaptedRules { force: adapted, report, .. } = adapted_rules(&f, &s, &Alone).unwrap();
         assert_eq!(report.subdivided, 0, "{report:?}");
         assert_eq!(adapted, report.fixed);
+    }
+
+    /// Shared out over processes, the pass gets each triangle's values back in another order:
+    /// the forces, the nodal stresses and the gradient must be the same to the bit.
+    #[test]
+    fn the_pass_does_not_depend_on_the_order_its_triangles_come_back_in() {
+        /// Every triangle here, its records gathered back in reverse order, as another
+        /// process's would come interleaved.
+        struct Reversed;
+        impl Share for Reversed {
+            fn mine(&self, _k: usize) -> bool {
+                true
+            }
+            fn gather(&self, local: Result<Vec<f64>, Error>) -> Result<Vec<f64>, Error> {
+                let v = local?;
+                let mut blocks = Vec::new();
+                let mut i = 0;
+                while i < v.len() {
+                    let len = v[i + 1] as usize;
+                    blocks.push(v[i..i + 2 + len].to_vec());
+                    i += 2 + len;
+                }
+                Ok(blocks.into_iter().rev().flatten().collect())
+            }
+        }
+        let f = fields();
+        let s = steep_setup(Rect { x0: -3.0, x1: 3.0, z0: -3.0, z1: 3.0 });
+        let (a, b) = (friction_pass(&f, &s, &Alone).unwrap(), friction_pass(&f, &s, &Reversed).unwrap());
+        assert_eq!([a.fx, a.fz, a.tau_max], [b.fx, b.fz, b.tau_max]);
+        assert_eq!(a.nodal.len(), b.nodal.len());
+        assert!(a.nodal.iter().zip(&b.nodal).all(|(x, y)| x == y));
+        let (ga, gb) = (friction_gradient(&f, &s, &a.rules, &Alone).unwrap(), friction_gradient(&f, &s, &b.rules, &Reversed).unwrap());
+        assert_eq!(ga.nodes, gb.nodes);
     }
 
     /// fx and fz of the pass, differenced in one nodal value, against the gradient: the chain
@@ -555,7 +665,7 @@ mod tests {
             rect: Rect { x0: -3.0, x1: 3.0, z0: -3.0, z1: 3.0 },
             load: 100.0,
         };
-        let grad = friction_gradient(&f, &s, &friction_pass(&f, &s).unwrap().rules).unwrap();
+        let grad = friction_gradient(&f, &s, &friction_pass(&f, &s, &Alone).unwrap().rules, &Alone).unwrap();
         let scale = grad.nodes.iter().flat_map(|(_, g)| g.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
         assert!(scale > 0.0);
         // Nodes inside the Hertz circle and next to it, vertices and midpoints.
@@ -573,7 +683,7 @@ mod tests {
                 let mut at = |d: f64| {
                     let v = if field == 'p' { &mut f.p } else { &mut f.h };
                     v[n as usize] += d;
-                    let r = friction_pass(&f, &s).unwrap();
+                    let r = friction_pass(&f, &s, &Alone).unwrap();
                     let v = if field == 'p' { &mut f.p } else { &mut f.h };
                     v[n as usize] -= d;
                     [r.fx, r.fz]
