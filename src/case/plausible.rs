@@ -142,7 +142,7 @@ fn quantities(s: &Scene, memory: Option<f64>) -> Vec<Quantity> {
             value: h.ph,
             hard: (1.0, 5e10),
             soft: (1e6, 4e9),
-            why: "above about 4 GPa steels yield (the model is linear elastic); below 1 MPa a modulus in MPa was more often given as Pa than the contact is soft (soft EHL: elastomers, gels, whose films are checked here only against a curve fit)",
+            why: "above about 4 GPa steels yield (the model is linear elastic); below 1 MPa a modulus written in MPa (and read as Pa) is likelier than a soft contact (soft EHL: elastomers, gels; their films are checked only against a curve fit, docs/practice.md)",
         },
     ];
     let lub = s.effects.lubrication == LubricationModel::Reynolds;

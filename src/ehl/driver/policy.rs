@@ -93,6 +93,8 @@ pub(super) struct Policy {
     pub(super) last_resorts: bool,
     /// When a continuation's ramp gives up ([`Start::ramp`]).
     pub(super) ramp: super::start::RampLimits,
+    /// The start is the Hertz start (some continuations are no milder problem from there).
+    pub(super) from_hertz: bool,
 }
 
 impl Policy {
@@ -126,6 +128,7 @@ impl Policy {
             plain_first: hertz || !attempt.continues,
             last_resorts: start.last_resorts(),
             ramp: start.ramp(),
+            from_hertz: hertz,
         }
     }
 }

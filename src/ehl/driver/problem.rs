@@ -88,7 +88,7 @@ fn stabilisation(scene: &Scene, penalty: f64) -> crate::reynolds::element::Stabi
 }
 
 /// Estimated dimensionless central film ([`Scene::film_estimate`]), at least 0.02. With
-/// Hamrock-Dowson's piezoviscous fit alone, a steel ball on PDMS (M = 31, L = 0.001)
+/// Hamrock-Dowson's piezoviscous fit alone, a steel ball on PDMS (M = 31, L = 2e-4)
 /// started from 65 nm, where its film is 7 um, and Newton stalled from every start.
 pub(super) fn hc_guess(scene: &Scene) -> f64 {
     (scene.film_estimate().unwrap_or(0.0) / scene.scales().film_scale()).max(0.02)
