@@ -278,46 +278,42 @@ pub fn post_point(
         PointResult { hc: st.hc * hs, hm: st.hm * hs, pmax: st.pmax * ph, load_error, fx: None, fz: None, profile_x0: Vec::new() };
     let fset = friction_setup(scene, rect);
     // The pass shares its triangles out over the ranks.
-    let computed = match (&fset, computed) {
+    let friction = match (&fset, computed) {
         (Some(fs), None) => Some(friction_pass(&fields, fs, &OverRanks(ctx))?),
-        (_, computed) => computed,
+        (Some(_), computed) => computed,
+        (None, _) => None,
     };
     if ctx.rank != 0 {
         return Ok(res);
     }
-    let friction = match &fset {
-        Some(_) => {
-            let f = computed.expect("the pass ran above");
+    if let Some(f) = &friction {
+        ctx.log(format!(
+            "friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s; the rule subdivided on {} of {} triangles, {} stress evaluations)",
+            scene.effects.friction,
+            f.fx,
+            f.fz,
+            f.fx_n,
+            f.fz_n,
+            f.tau_max,
+            f.seconds,
+            f.quadrature.subdivided,
+            f.quadrature.triangles,
+            f.quadrature.evaluations
+        ));
+        // A lubricated contact's friction coefficient is of order 0.01-0.1; above 1 the
+        // Newtonian law has carried exp(alpha p) viscosities into shear stresses no
+        // lubricant sustains (the limiting shear stress is what Ree-Eyring adds).
+        if f.fx.hypot(f.fz) > 1.0 {
             ctx.log(format!(
-                "friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s; the rule subdivided on {} of {} triangles, {} stress evaluations)",
+                "warning: the friction coefficient sqrt(fx^2 + fz^2) = {:.3e} is above 1: with effects.friction = \"{}\" the shear stress reaches {:.3e} Pa, far above any lubricant's limiting shear stress; effects.friction = \"ree-eyring\" bounds it",
+                f.fx.hypot(f.fz),
                 scene.effects.friction,
-                f.fx,
-                f.fz,
-                f.fx_n,
-                f.fz_n,
-                f.tau_max,
-                f.seconds,
-                f.quadrature.subdivided,
-                f.quadrature.triangles,
-                f.quadrature.evaluations
+                f.tau_max
             ));
-            // A lubricated contact's friction coefficient is of order 0.01-0.1; above 1 the
-            // Newtonian law has carried exp(alpha p) viscosities into shear stresses no
-            // lubricant sustains (the limiting shear stress is what Ree-Eyring adds).
-            if f.fx.hypot(f.fz) > 1.0 {
-                ctx.log(format!(
-                    "warning: the friction coefficient sqrt(fx^2 + fz^2) = {:.3e} is above 1: with effects.friction = \"{}\" the shear stress reaches {:.3e} Pa, far above any lubricant's limiting shear stress; effects.friction = \"ree-eyring\" bounds it",
-                    f.fx.hypot(f.fz),
-                    scene.effects.friction,
-                    f.tau_max
-                ));
-            }
-            res.fx = Some(f.fx);
-            res.fz = Some(f.fz);
-            Some(f)
         }
-        None => None,
-    };
+        res.fx = Some(f.fx);
+        res.fz = Some(f.fz);
+    }
     let tau = |x: f64, z: f64| -> Result<Option<[f64; 2]>, Error> {
         match &fset {
             Some(fs) => stress_at(&fields, fs, x, z).transpose(),

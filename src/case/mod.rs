@@ -565,6 +565,12 @@ impl Scene {
         Some(self.viscosity_law_unchecked(l).expect("validated scene"))
     }
 
+    /// The viscosity's rise over the contact, ln(eta(p_H)/eta_R), or None without a
+    /// lubricant.
+    pub fn viscosity_rise(&self) -> Option<f64> {
+        Some(self.viscosity_law()?.log_ratio_and_derivative(self.hertz().ph).0)
+    }
+
     /// The density law selected by `effects.density`, or None without a lubricant.
     pub fn density_law(&self) -> Option<DensityLaw> {
         let rho_r = self.lubricant.as_ref()?.density;

@@ -191,7 +191,7 @@ fn quantities(s: &Scene, memory: Option<f64>) -> Vec<Quantity> {
                 name: "viscosity_rise",
                 what: "viscosity rise ln(eta(p_H)/eta_R) at the Hertz pressure".into(),
                 from: "lubricant.pressure_viscosity, lubricant.roelands_exponent, lubricant.viscosity, operating.load",
-                value: law.log_ratio_and_derivative(h.ph).0,
+                value: s.viscosity_rise().expect("a lubricant"),
                 hard: (0.0, 300.0),
                 soft: (0.0, 80.0),
                 why: "above e^80 (1e35) the lubricant is a glass and the isothermal piezoviscous law is meaningless; above e^300 the Jacobian's entries overflow double precision",

@@ -411,20 +411,21 @@ impl Adapting<'_> {
 fn adapted_rules(fields: &dyn FaceSolution, s: &FrictionSetup, share: &dyn Share) -> Result<AdaptedRules, Error> {
     let mesh = fields.mesh();
     let tris: Vec<usize> = (0..mesh.contact_tris.len()).filter(|&t| in_rect(fields, t, &s.rect)).collect();
-    let area_of = |tf: &TriFields| crate::fem::p2tri::tri_area(&tf.v) * s.a * s.a;
+    // Each triangle's area (m^2).
+    let areas: Vec<f64> = tris.iter().map(|&t| crate::fem::p2tri::tri_area(&TriFields::new(fields, t).v) * s.a * s.a).collect();
     // The fixed rule on every triangle: the coarse value each adaptation starts from, and
     // the scale of the tolerance.
     let fixed = shared(share, tris.len(), |k| {
         let tf = TriFields::new(fields, tris[k]);
-        let mut a = Adapting { tf: &tf, s, area: area_of(&tf), points: Vec::new(), evaluations: 0 };
+        let mut a = Adapting { tf: &tf, s, area: areas[k], points: Vec::new(), evaluations: 0 };
         Ok(a.force(&sub_points(&WHOLE, 1.0))?.to_vec())
     })?;
     let mut report = QuadratureReport { triangles: tris.len(), evaluations: 12 * tris.len(), ..Default::default() };
     let (mut total, mut area_total, mut absolute) = ([0.0; 2], 0.0, 0.0);
-    for (&t, f) in tris.iter().zip(&fixed) {
+    for (f, area) in fixed.iter().zip(&areas) {
         total[0] += f[0];
         total[1] += f[1];
-        area_total += area_of(&TriFields::new(fields, t));
+        area_total += area;
         absolute += f[0].hypot(f[1]);
     }
     report.fixed = total;
@@ -432,7 +433,7 @@ fn adapted_rules(fields: &dyn FaceSolution, s: &FrictionSetup, share: &dyn Share
     // Each triangle's adapted rule: its force, its evaluations, then its points (l, w).
     let adapted = shared(share, tris.len(), |k| {
         let tf = TriFields::new(fields, tris[k]);
-        let area = area_of(&tf);
+        let area = areas[k];
         let mut a = Adapting { tf: &tf, s, area, points: Vec::new(), evaluations: 0 };
         let tol = QUADRATURE_TOL * scale * area / area_total;
         let f = a.take(&WHOLE, 1.0, [fixed[k][0], fixed[k][1]], tol, 0)?;

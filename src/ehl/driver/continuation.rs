@@ -204,9 +204,9 @@ struct Homotopy {
 /// retry at 83,937 unknowns). From a coarser level's pressure it stays: there its first
 /// step, solved with the bt line search, is what converges (docs/practice.md, "Soft EHL").
 fn homotopies(scene: &Scene, from_hertz: bool) -> Vec<Homotopy> {
-    let rise = scene.viscosity_law().map_or(0.0, |v| v.log_ratio_and_derivative(scene.hertz().ph).0);
     let alpha = scene.lubricant.as_ref().and_then(|l| l.pressure_viscosity).unwrap_or(0.0);
-    let alpha = if from_hertz && rise < MILD_VISCOSITY_RISE { 0.0 } else { alpha };
+    let mild = from_hertz && scene.viscosity_rise().unwrap_or(0.0) < MILD_VISCOSITY_RISE;
+    let alpha = if mild { 0.0 } else { alpha };
     let z = scene.lubricant.as_ref().and_then(|l| l.roelands_exponent);
     let ue = scene.operating.entrainment_speed.unwrap_or(0.0);
     let tilt = scene.operating.tilt_angle;
