@@ -281,8 +281,13 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         }
         // A level after one that plain Newton could not solve from its own coarser level
         // goes to the continuation at once (level 0 is not a guide: its start is the Hertz
-        // pressure, not a coarser level's).
-        let plain = !(k >= 2 && previous.as_ref().is_some_and(|p| p.sol.continued));
+        // pressure, not a coarser level's), unless that continuation was a load or speed
+        // path: its ramp takes four or more solves where plain Newton takes one. M = 1000,
+        // L = 0.01 with level 0 at 0.0625 a (the load path from L/5.2): level 1 failed plain
+        // Newton, and levels 2-4 went through the load path at once, 63-87 iterations each,
+        // where plain Newton from a finer coarser level took 20-25.
+        let plain =
+            !(k >= 2 && previous.as_ref().is_some_and(|p| p.sol.continued && !p.sol.milder.as_ref().is_some_and(|m| m.last_resort)));
         // From a coarser level's pressure, plain Newton's few steps do not pay back a
         // condensation; a continuation's many steps do, on the condensed coupling's cheaper
         // ones (M = 500, L = 15's level 2, 2,684 pressure unknowns: 16.2 s condensed, 36

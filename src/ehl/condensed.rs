@@ -447,6 +447,10 @@ impl EhlProblem for CondensedSystem<'_> {
         self.collapse.take()
     }
 
+    fn h0_index(&self) -> usize {
+        self.layout.h0()
+    }
+
     fn set_velocity(&mut self, velocity: Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync>) -> bool {
         for e in &mut self.elements {
             e.vel = e.verts.map(|v| velocity(v[0], v[1]));

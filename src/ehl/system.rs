@@ -308,9 +308,14 @@ pub trait EhlProblem: Problem {
     fn take_collapse(&mut self) -> Option<[f64; 2]> {
         None
     }
+    /// The index of H0 in the state.
+    fn h0_index(&self) -> usize;
 }
 
 impl EhlProblem for EhlSystem<'_> {
+    fn h0_index(&self) -> usize {
+        self.layout.h0 as usize
+    }
     fn take_collapse(&mut self) -> Option<[f64; 2]> {
         self.collapse.take()
     }

@@ -7,7 +7,7 @@
 //! kept in the path.
 use super::diagnostics::Collapse;
 use super::policy::{newton_atol, set_newton_linear_solver, Policy, INTERMEDIATE_ATOL};
-use super::problem::{lambda_bar, lubricant, penalty, velocity_field};
+use super::problem::{hc_guess, lambda_bar, lubricant, penalty, velocity_field};
 use super::start::RampLimits;
 use crate::case::Scene;
 use crate::context::Context;
@@ -78,6 +78,9 @@ pub struct ContinuationPath {
     pub parameter: &'static str,
     pub ts: Vec<f64>,
     pub x: Vec<f64>,
+    /// The parameter is a last resort (load, speed): a path that changes the film's whole
+    /// shape, several steps long.
+    pub last_resort: bool,
 }
 
 /// A milder problem's state to start a continuation from: a coarser level's converged state
@@ -149,17 +152,26 @@ impl Parameter {
         }
     }
 
-    /// The parameter changes the entrainment velocity field.
     /// Load and speed: continuations that change the film's whole shape, tried after the
-    /// ones nearest the scene (tilt, pressure-viscosity) failed. From a coarser level's
-    /// pressure they have not converged on any level measured (M = 100, L = 20 at
-    /// 0.0625 a and 0.03125 a: L/8 to L/64 and 2 Ue to 32 Ue all fail, 210 s).
+    /// ones nearest the scene (tilt, pressure-viscosity) failed. Their search from a
+    /// coarser level's pressure has not converged on any level measured (M = 100, L = 20 at
+    /// 0.0625 a and 0.03125 a: L/8 to L/64 and 2 Ue to 32 Ue all fail, 210 s, measured
+    /// before a milder problem's start had its own film, [`film_gain`]).
     fn last_resort(self) -> bool {
         matches!(self, Parameter::Load(_) | Parameter::Speed(_))
     }
 
+    /// The parameter changes the entrainment velocity field.
     fn kinematic(self) -> bool {
         matches!(self, Parameter::Tilt(_))
+    }
+
+    /// The parameter changes the film in the units of its own Hertz contact (X = x/a,
+    /// H = h R/a^2): a lighter load has a smaller a, so the same film is a thicker H; a
+    /// faster speed has a thicker film. The dimensionless Hertz pressure and its deflection
+    /// are the same at every load, so only H0 of a start is wrong for another value.
+    fn moves_film(self) -> bool {
+        matches!(self, Parameter::Load(_) | Parameter::Speed(_))
     }
 
     /// A smaller t gives a thinner film (pressure-viscosity: hc grows about as alpha^0.5),
@@ -167,6 +179,23 @@ impl Parameter {
     fn thins_film(self) -> bool {
         matches!(self, Parameter::PressureViscosity { .. })
     }
+}
+
+/// How much a start of `from` at `p = from_t` raises its H0 for a solve at `p = t`: the
+/// estimated central film's gain ([`hc_guess`]) where the film at t is the thicker. At L/8
+/// the Hertz start's H0, the scene's film, is about a fifth of the milder problem's own.
+/// A thinner film is not imposed: a start whose film is too thick only needs the load
+/// balance to lower H0, one too thin can close the film at its first step.
+fn film_gain(from: &Scene, p: Parameter, from_t: f64, t: f64) -> f64 {
+    if !p.moves_film() {
+        return 0.0;
+    }
+    let at = |t: f64| {
+        let mut sc = from.clone();
+        p.apply(&mut sc, t);
+        hc_guess(&sc)
+    };
+    (at(t) - at(from_t)).max(0.0)
 }
 
 /// The viscosity rise over the contact, ln(eta(p_H)/eta_R), below which a smaller alpha is
@@ -398,19 +427,32 @@ impl Newton<'_> {
         Ok(self.x.gather_all()?)
     }
 
-    /// One Newton solve of `from` with `p` at t, from `start`; the step is logged (`what`
-    /// before the parameter's value) and kept in the path. Returns the report and, if
-    /// converged, the state.
+    /// One Newton solve of `from` with `p` at t, from `start`, a state at `p = from_t`
+    /// (its H0 raised by [`film_gain`]); the step is logged (`what` before the parameter's
+    /// value) and kept in the path. Returns the report and, if converged, the state.
+    #[allow(clippy::too_many_arguments)]
     fn solve_at(
         &mut self,
         from: &Scene,
         p: Parameter,
-        t: f64,
+        (from_t, t): (f64, f64),
         system: &mut dyn EhlProblem,
         start: &[f64],
         what: &str,
     ) -> Result<(SolveReport, Option<Vec<f64>>), Error> {
         crate::interrupt::check("the continuation")?;
+        let gain = film_gain(from, p, from_t, t);
+        let raised;
+        let start = if gain > 0.0 {
+            let mut x = start.to_vec();
+            x[system.h0_index()] += gain;
+            raised = x;
+            &raised[..]
+        } else {
+            start
+        };
+        let what = if gain > 0.0 { format!("{what}(H0 + {gain:.3e}, its film) ") } else { what.to_string() };
+        let what = what.as_str();
         let mut sc = from.clone();
         p.apply(&mut sc, t);
         if p.kinematic() {
@@ -449,7 +491,7 @@ impl Newton<'_> {
         let (p, lowest) = (h.parameter, h.ramp.lowest);
         let mut t = h.ramp.first;
         while t >= lowest {
-            if let (_, Some(xs)) = self.solve_at(from, p, t, system, x0, &format!("{label} at "))? {
+            if let (_, Some(xs)) = self.solve_at(from, p, (1.0, t), system, x0, &format!("{label} at "))? {
                 return Ok(Some((t, xs)));
             }
             // heavy-3gpa: the film closed at alpha/2, alpha/4 and alpha/8 alike (4 min of
@@ -489,7 +531,7 @@ impl Newton<'_> {
         let mut below = vec![t];
         while t < 1.0 {
             let (next, planned) = steps.next(t);
-            let (r, xs) = self.solve_at(from, h.parameter, next, system, &state, "")?;
+            let (r, xs) = self.solve_at(from, h.parameter, (t, next), system, &state, "")?;
             let converged = xs.is_some();
             if let Some(xs) = xs {
                 if next < 1.0 {
@@ -664,7 +706,7 @@ pub(super) fn newton_with_continuation(
             let mut found = None;
             let mut schedule: &[f64] = &[];
             if let Some(m) = milder.as_ref().filter(|m| m.parameter == h.parameter.name() && !m.ts.is_empty()) {
-                if let (_, Some(xs)) = nw.solve_at(&base, h.parameter, m.ts[0], system, m.x, &format!("{} at ", m.label))? {
+                if let (_, Some(xs)) = nw.solve_at(&base, h.parameter, (m.ts[0], m.ts[0]), system, m.x, &format!("{} at ", m.label))? {
                     found = Some((m.ts[0], xs));
                     schedule = m.ts;
                 }
@@ -680,7 +722,8 @@ pub(super) fn newton_with_continuation(
             }
             if done {
                 state = Some(xs);
-                reached_from = Some(ContinuationPath { parameter: h.parameter.name(), ts: below, x: first });
+                reached_from =
+                    Some(ContinuationPath { parameter: h.parameter.name(), ts: below, x: first, last_resort: h.parameter.last_resort() });
                 break;
             }
             let t_last = below.last().copied().unwrap_or(t);
@@ -846,6 +889,31 @@ mod tests {
         assert_eq!(tried_with(t0, 2.0, &[], RampLimits::DEFAULT, ok), (false, vec![1.0]));
         let (done, t) = tried_with(t0, 2.0, &[], RampLimits::PATIENT, ok);
         assert!(done && t.len() == 3 && (t[1] - t0 * r).abs() < 1e-12, "{t:?}");
+    }
+
+    /// A milder load's start gets its own film: Hamrock-Dowson's hc goes as W^-0.067 and
+    /// the Hertz radius a as W^(1/3), so the dimensionless film H = h R/a^2 of L/8 is
+    /// 8^(2/3 + 0.067) = 4.6 times the scene's. The pressure-viscosity continuation keeps
+    /// its start, and no step thins a start's film.
+    #[test]
+    fn a_lighter_load_starts_from_its_own_thicker_film() {
+        use super::{film_gain, hc_guess};
+        let scene = crate::case::parse_scene(include_str!("../../../cases/paper/table2-ue2.toml"), "table2-ue2").unwrap();
+        let load = Parameter::Load(scene.operating.load);
+        let h = hc_guess(&scene);
+        let ratio = 1.0 + film_gain(&scene, load, 1.0, 0.125) / h;
+        assert!((ratio / 8f64.powf(2.0 / 3.0 + 0.067) - 1.0).abs() < 1e-3, "{ratio}");
+        let (g, g8, g4) = (film_gain(&scene, load, 0.25, 0.125), film_gain(&scene, load, 1.0, 0.125), film_gain(&scene, load, 1.0, 0.25));
+        assert!((g - (g8 - g4)).abs() < 1e-12 * g8, "{g} against {}", g8 - g4);
+        // A heavier load or a slower speed: the start keeps its thicker film.
+        assert_eq!(film_gain(&scene, load, 0.125, 1.0), 0.0);
+        let ue = scene.operating.entrainment_speed.unwrap();
+        assert_eq!(film_gain(&scene, Parameter::Speed(ue), 0.25, 1.0), 0.0);
+        // Four times the speed: hc as Ue^0.67 at the same a.
+        let ratio = 1.0 + film_gain(&scene, Parameter::Speed(ue), 1.0, 0.25) / h;
+        assert!((ratio / 4f64.powf(0.67) - 1.0).abs() < 1e-3, "{ratio}");
+        let pv = Parameter::PressureViscosity { alpha: 2e-8, z: None };
+        assert_eq!(film_gain(&scene, pv, 1.0, 0.5), 0.0);
     }
 
     #[test]
