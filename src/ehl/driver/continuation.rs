@@ -430,7 +430,6 @@ impl Newton<'_> {
     /// One Newton solve of `from` with `p` at t, from `start`, a state at `p = from_t`
     /// (its H0 raised by [`film_gain`]); the step is logged (`what` before the parameter's
     /// value) and kept in the path. Returns the report and, if converged, the state.
-    #[allow(clippy::too_many_arguments)]
     fn solve_at(
         &mut self,
         from: &Scene,
