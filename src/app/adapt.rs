@@ -286,8 +286,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // L = 0.01 with level 0 at 0.0625 a (the load path from L/5.2): level 1 failed plain
         // Newton, and levels 2-4 went through the load path at once, 63-87 iterations each,
         // where plain Newton from a finer coarser level took 20-25.
-        let plain =
-            !(k >= 2 && previous.as_ref().is_some_and(|p| p.sol.continued && !p.sol.milder.as_ref().is_some_and(|m| m.last_resort)));
+        let continued_near = previous.as_ref().is_some_and(|p| p.sol.continued && !p.sol.milder.as_ref().is_some_and(|m| m.last_resort));
+        let plain = !(k >= 2 && continued_near);
         // From a coarser level's pressure, plain Newton's few steps do not pay back a
         // condensation; a continuation's many steps do, on the condensed coupling's cheaper
         // ones (M = 500, L = 15's level 2, 2,684 pressure unknowns: 16.2 s condensed, 36

@@ -77,13 +77,23 @@ fn shared(share: &dyn Share, n: usize, mut f: impl FnMut(usize) -> Result<Vec<f6
     };
     let all = share.gather(local())?;
     let mut items: Vec<Option<Vec<f64>>> = vec![None; n];
+    for (k, v) in records(&all) {
+        items[k] = Some(v.to_vec());
+    }
+    items.into_iter().map(|v| v.ok_or_else(|| Error::other("friction pass: a triangle no process evaluated"))).collect()
+}
+
+/// The records of a gathered [`shared`] buffer: each item's index and its values (the
+/// buffer holds k, the number of values, then the values, item after item).
+fn records(all: &[f64]) -> Vec<(usize, &[f64])> {
+    let mut out = Vec::new();
     let mut i = 0;
     while i + 1 < all.len() {
         let (k, len) = (all[i] as usize, all[i + 1] as usize);
-        items[k] = Some(all[i + 2..i + 2 + len].to_vec());
+        out.push((k, &all[i + 2..i + 2 + len]));
         i += 2 + len;
     }
-    items.into_iter().map(|v| v.ok_or_else(|| Error::other("friction pass: a triangle no process evaluated"))).collect()
+    out
 }
 
 /// What the pass needs besides the fields: the shear law, the viscosity law, the surface
@@ -411,15 +421,16 @@ impl Adapting<'_> {
 fn adapted_rules(fields: &dyn FaceSolution, s: &FrictionSetup, share: &dyn Share) -> Result<AdaptedRules, Error> {
     let mesh = fields.mesh();
     let tris: Vec<usize> = (0..mesh.contact_tris.len()).filter(|&t| in_rect(fields, t, &s.rect)).collect();
-    // Each triangle's area (m^2).
-    let areas: Vec<f64> = tris.iter().map(|&t| crate::fem::p2tri::tri_area(&TriFields::new(fields, t).v) * s.a * s.a).collect();
     // The fixed rule on every triangle: the coarse value each adaptation starts from, and
-    // the scale of the tolerance.
+    // the scale of the tolerance; with the triangle's area (m^2).
     let fixed = shared(share, tris.len(), |k| {
         let tf = TriFields::new(fields, tris[k]);
-        let mut a = Adapting { tf: &tf, s, area: areas[k], points: Vec::new(), evaluations: 0 };
-        Ok(a.force(&sub_points(&WHOLE, 1.0))?.to_vec())
+        let area = crate::fem::p2tri::tri_area(&tf.v) * s.a * s.a;
+        let mut a = Adapting { tf: &tf, s, area, points: Vec::new(), evaluations: 0 };
+        let f = a.force(&sub_points(&WHOLE, 1.0))?;
+        Ok(vec![f[0], f[1], area])
     })?;
+    let areas: Vec<f64> = fixed.iter().map(|f| f[2]).collect();
     let mut report = QuadratureReport { triangles: tris.len(), evaluations: 12 * tris.len(), ..Default::default() };
     let (mut total, mut area_total, mut absolute) = ([0.0; 2], 0.0, 0.0);
     for (f, area) in fixed.iter().zip(&areas) {
@@ -628,14 +639,11 @@ mod tests {
             }
             fn gather(&self, local: Result<Vec<f64>, Error>) -> Result<Vec<f64>, Error> {
                 let v = local?;
-                let mut blocks = Vec::new();
-                let mut i = 0;
-                while i < v.len() {
-                    let len = v[i + 1] as usize;
-                    blocks.push(v[i..i + 2 + len].to_vec());
-                    i += 2 + len;
-                }
-                Ok(blocks.into_iter().rev().flatten().collect())
+                Ok(super::records(&v)
+                    .into_iter()
+                    .rev()
+                    .flat_map(|(k, r)| [k as f64, r.len() as f64].into_iter().chain(r.iter().copied()))
+                    .collect())
             }
         }
         let f = fields();
