@@ -18,6 +18,18 @@ fn moes_m10(name: &str, set: &[&str]) -> (std::process::Output, serde_json::Valu
     (out, summary)
 }
 
+/// Writes into `dir` a point of the Moes map as `ci/moes-map` writes it (Barus, incompressible,
+/// uniform entrainment, steel on steel, R = 0.08 m, eta 0.012 Pa s, Ue = 2 m/s, no `[mesh]`)
+/// at `load` (N) and `alpha` (Pa^-1), and returns its path.
+fn moes_scene(dir: &std::path::Path, name: &str, load: &str, alpha: &str) -> String {
+    let toml = format!(
+        "name = \"{name}\"\n[effects]\nviscosity = \"barus\"\ndensity = \"incompressible\"\nkinematics = \"uniform\"\nfriction = \"none\"\n\
+         [geometry]\nball_radius = 0.08\n[materials.ball]\nyoung_modulus = 210e9\npoisson_ratio = 0.3\n[materials.disc]\nyoung_modulus = 210e9\npoisson_ratio = 0.3\n\
+         [lubricant]\nviscosity = 0.012\npressure_viscosity = {alpha}\n[operating]\nload = {load}\nentrainment_speed = 2.0\nslide_to_roll = 0.0\ntilt_angle = 90.0\n"
+    );
+    write_scene(dir, &format!("{name}.toml"), &toml)
+}
+
 /// The adjoints of hc and hm, checked against two more solves: the films' exponents in
 /// eta_R Ue from the adjoints (`output.speed_exponents`: -z . dF/d ln lambda_bar / J) equal
 /// the central difference of ln hc and ln hm over Ue (1.01)^(+-1) on the same fixed mesh.
@@ -305,11 +317,7 @@ fn a_soft_contact_converges_from_the_isoviscous_film() {
 #[test]
 fn a_heavy_isoviscous_point_goes_up_in_load_from_its_own_lighter_film() {
     let dir = scratch("accuracy_load_path");
-    let toml = "name = \"moes-m100-l0.01\"\n[effects]\nviscosity = \"barus\"\ndensity = \"incompressible\"\nkinematics = \"uniform\"\n\
-        friction = \"none\"\n[geometry]\nball_radius = 0.08\n[materials.ball]\nyoung_modulus = 210e9\npoisson_ratio = 0.3\n\
-        [materials.disc]\nyoung_modulus = 210e9\npoisson_ratio = 0.3\n[lubricant]\nviscosity = 0.012\npressure_viscosity = 3.41255e-11\n\
-        [operating]\nload = 302.404\nentrainment_speed = 2.0\nslide_to_roll = 0.0\ntilt_angle = 90.0\n";
-    let scene = write_scene(&dir, "moes-m100-l0.01.toml", toml);
+    let scene = moes_scene(&dir, "moes-m100-l0.01", "302.404", "3.41255e-11");
     let run = dir.join("run");
     // The budget stops the run after its first level (exit 4), on the default 0.25 a grid.
     let args = [scene.as_str(), "--output", run.to_str().unwrap(), "--set", "accuracy.max_unknowns=10000", "--set", "output.png=false"];
@@ -419,16 +427,9 @@ fn the_gradient_jump_term_removes_the_pressure_scallops() {
 #[test]
 fn a_heavy_moes_point_continues_level_by_level_from_the_coarser_state() {
     let dir = scratch("accuracy_m1000");
-    let scene = dir.join("moes-m1000-l10.toml");
-    std::fs::write(
-        &scene,
-        "name = \"moes-m1000-l10\"\n[effects]\nviscosity = \"barus\"\ndensity = \"incompressible\"\nkinematics = \"uniform\"\nfriction = \"none\"\n\
-         [geometry]\nball_radius = 0.08\n[materials.ball]\nyoung_modulus = 210e9\npoisson_ratio = 0.3\n[materials.disc]\nyoung_modulus = 210e9\npoisson_ratio = 0.3\n\
-         [lubricant]\nviscosity = 0.012\npressure_viscosity = 3.41255e-08\n[operating]\nload = 3024.04\nentrainment_speed = 2.0\nslide_to_roll = 0.0\ntilt_angle = 90.0\n",
-    )
-    .unwrap();
+    let scene = moes_scene(&dir, "moes-m1000-l10", "3024.04", "3.41255e-08");
     let run = dir.join("run");
-    let args = [scene.to_str().unwrap(), "--output", run.to_str().unwrap(), "--set", "accuracy.max_levels=2", "--set", "output.png=false"];
+    let args = [scene.as_str(), "--output", run.to_str().unwrap(), "--set", "accuracy.max_levels=2", "--set", "output.png=false"];
     let out = mpirun(2, &args);
     let log = text(&out);
     assert_eq!(out.status.code(), Some(4), "{log}");
