@@ -30,7 +30,7 @@
 //!    triangle at the smallest size), the
 //!    last level's result is written with its estimated error, `accuracy.reached` is
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
-use super::estimate::Estimate;
+use super::estimate::{raised_penalty, Estimate, PenaltyError, SHORT_PENALTY_SHARE};
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, PointResult, Setup};
 use super::marking::{
@@ -86,6 +86,9 @@ pub struct Level {
     /// level's marking quartered triangles ([`super::marking::QUARTER_RATIO`]), else 1. The
     /// estimate's crossing guard allows a change to contract by that many steps.
     pub halvings: u32,
+    /// The cavitation penalty the level was solved at and its estimated error (where the
+    /// penalty was staged, [`super::estimate::PenaltyError`]).
+    pub penalty: Option<PenaltyError>,
 }
 
 impl Level {
@@ -134,6 +137,8 @@ struct Solved {
     exponents: Option<serde_json::Value>,
     /// The gradient-jump factor the level was solved with (it may be raised after it).
     gradient_jump: f64,
+    /// The cavitation penalty the level was solved for (it may be raised after it).
+    penalty: f64,
     /// The marking of the next level (None on the last).
     marking: Option<Marking>,
     /// The level's friction pass, which the result's post-processing reports (a second
@@ -299,6 +304,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         };
         // The adjoint after the level solves on Newton's last factorisation.
         solver.keep_newton(acc.marking > 0.0 || scene.output.speed_exponents);
+        // A staged penalty that stalls short of the scene's is judged by its error here.
+        solver.accept_short_penalty(true);
         let sol = match (&previous, earlier) {
             (Some(prev), _) => {
                 let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
@@ -369,7 +376,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     }
                     None => solver.solve_from(ctx, scene, start),
                 };
-                let solved = collective::agree(&ctx.world, solved);
+                let solved = collective::agree(&ctx.world, penalty_judged(ctx, &setup, target, solved));
                 match solved {
                     Ok(sol) => sol,
                     Err(e) if crate::interrupt::agreed() == 0 && tries == Tries::Plain && newton_failed(ctx, &e) => {
@@ -467,35 +474,37 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     }
                 }
             }
-            (None, Some(e)) => e.solve(ctx, scene, &solver)?,
-            (None, None) => match collective::agree(&ctx.world, onward(ctx, scene, &solver, from.as_ref())) {
-                Ok(sol) => sol,
-                // A first mesh too coarse for the film (at low speed or high load the side
-                // lobes and the outlet constriction are narrower than 0.25 a, and the film
-                // closes there on it: cases/hard/slow, heavy-3gpa) is refined in the Hertz
-                // zone and, finer, around the radii where the film closed, and solved again
-                // without the gradient-jump term ([`without_gradient_jump`]); a film that
-                // closes at a spin pole closes on any mesh.
-                // Every rank decides the same: only Newton's own failure (the same on every
-                // rank) is retried, not one rank's local fault.
-                Err(e) if crate::interrupt::agreed() == 0 && first_retries < FIRST_LEVEL_RETRIES && newton_failed(ctx, &e) => {
-                    let why = format!("did not converge on its mesh ({})", reason(&e));
-                    let closed = closures(ctx, &e);
-                    next = Some(NextMesh::halving(first_level_again(ctx, &setup.mesh, growth, &why, &closed)));
-                    if !closed.is_empty() {
-                        without_gradient_jump(ctx, &mut own);
+            (None, Some(e)) => collective::agree(&ctx.world, penalty_judged(ctx, &setup, target, e.solve(ctx, scene, &solver)))?,
+            (None, None) => {
+                match collective::agree(&ctx.world, penalty_judged(ctx, &setup, target, onward(ctx, scene, &solver, from.as_ref()))) {
+                    Ok(sol) => sol,
+                    // A first mesh too coarse for the film (at low speed or high load the side
+                    // lobes and the outlet constriction are narrower than 0.25 a, and the film
+                    // closes there on it: cases/hard/slow, heavy-3gpa) is refined in the Hertz
+                    // zone and, finer, around the radii where the film closed, and solved again
+                    // without the gradient-jump term ([`without_gradient_jump`]); a film that
+                    // closes at a spin pole closes on any mesh.
+                    // Every rank decides the same: only Newton's own failure (the same on every
+                    // rank) is retried, not one rank's local fault.
+                    Err(e) if crate::interrupt::agreed() == 0 && first_retries < FIRST_LEVEL_RETRIES && newton_failed(ctx, &e) => {
+                        let why = format!("did not converge on its mesh ({})", reason(&e));
+                        let closed = closures(ctx, &e);
+                        next = Some(NextMesh::halving(first_level_again(ctx, &setup.mesh, growth, &why, &closed)));
+                        if !closed.is_empty() {
+                            without_gradient_jump(ctx, &mut own);
+                        }
+                        first_retries += 1;
+                        tried_s += t0.elapsed().as_secs_f64();
+                        drop(solver);
+                        let further = |r: &Reached| !matches!(&from, Some(Onward::Reached(_, f)) if f.t >= r.t);
+                        if let Some(r) = reached(ctx, &e).filter(further) {
+                            from = Some(Onward::Reached(setup, r));
+                        }
+                        continue;
                     }
-                    first_retries += 1;
-                    tried_s += t0.elapsed().as_secs_f64();
-                    drop(solver);
-                    let further = |r: &Reached| !matches!(&from, Some(Onward::Reached(_, f)) if f.t >= r.t);
-                    if let Some(r) = reached(ctx, &e).filter(further) {
-                        from = Some(Onward::Reached(setup, r));
-                    }
-                    continue;
+                    Err(e) => return Err(e),
                 }
-                Err(e) => return Err(e),
-            },
+            }
         };
         let fields = FieldsOnFace::new(&setup.mesh, &setup.layout, &sol.x);
         let st = fields.stats();
@@ -549,6 +558,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             est: None,
             cut: cut.take(),
             halvings: if k == 0 { 1 } else { next.as_ref().map_or(1, |m| m.halvings) },
+            penalty: penalty_of(&setup, &sol, [st.hc, st.hm]),
         };
         over.clear();
         levels.push(level);
@@ -560,7 +570,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let level = levels.last_mut().expect("the level just pushed");
         level.est = est;
         ctx.log(format!(
-            "accuracy: level {k}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}; estimated error {}",
+            "accuracy: level {k}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}{}; estimated error {}",
             level.contact_triangles,
             level.min_size,
             level.cut.map_or(String::new(), |c| format!(
@@ -578,6 +588,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             level.hm_at[1],
             level.pmax,
             level.friction.map_or(String::new(), |f| format!(", fx = {:.5e}, fz = {:.5e}", f[0], f[1])),
+            level.penalty.filter(|p| p.xi < p.scene_xi).map_or(String::new(), |p| format!(" (cavitation penalty xi = {:.3e}, short of the scene's {:e})", p.xi, p.scene_xi)),
             level.est.map_or("- (first level)".to_string(), |e| e.describe())
         ));
         let reached = k >= 2 && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
@@ -638,6 +649,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             condensation_s,
             exponents,
             gradient_jump: scene.reynolds.gradient_jump,
+            penalty: scene.reynolds.penalty,
             marking: marked,
             friction,
         };
@@ -670,6 +682,19 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
             return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
         }
+        // The mesh's refinement cannot take the penalty's own error below the target: a
+        // penalty part above a quarter of it raises the penalty tenfold for the levels after
+        // (docs/accuracy.md, "The cavitation penalty's own error").
+        if let Some(xi) = levels.last().and_then(|l| l.penalty).and_then(|p| raised_penalty(&p, target)) {
+            let p = levels.last().and_then(|l| l.penalty).expect("the level's penalty");
+            ctx.log(format!(
+                "accuracy: the cavitation penalty's part of the estimate (hc {:.3} %, hm {:.3} %) is above a quarter of the target; reynolds.penalty raised from {:e} to {xi:e} for the levels after level {k}",
+                100.0 * p.hc,
+                100.0 * p.hm,
+                p.scene_xi
+            ));
+            own.reynolds.penalty = xi;
+        }
         previous = Some(here);
     }
 }
@@ -696,6 +721,52 @@ fn newton_failure(e: &Error) -> bool {
 /// Hertz circle (the driver's diagnosis, in its message).
 fn closed_at_spin_pole(e: &Error) -> bool {
     newton_failure(e) && e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE)
+}
+
+/// The cavitation penalty's estimated error on a level's films `films` (hc, hm), from its
+/// state at the staged penalty, when the penalty was staged.
+fn penalty_of(setup: &Setup, sol: &EhlSolution, films: [f64; 2]) -> Option<PenaltyError> {
+    let staged = sol.penalty.as_ref()?;
+    let film = |x: &[f64]| {
+        let st = FieldsOnFace::new(&setup.mesh, &setup.layout, x).stats();
+        [st.hc, st.hm]
+    };
+    let mut xis = vec![staged.base_xi];
+    let mut at = vec![film(&staged.base_x)];
+    if let Some((xi, x)) = staged.mid.as_ref().filter(|(xi, _)| *xi < staged.xi) {
+        xis.push(*xi);
+        at.push(film(x));
+    }
+    xis.push(staged.xi);
+    at.push(films);
+    Some(PenaltyError::of(&xis, &at, staged.scene_xi))
+}
+
+/// A solution whose staged cavitation penalty stalled short of the scene's
+/// ([`EhlSolver::accept_short_penalty`]) is kept when the penalty's estimated error of hc
+/// and hm is at most [`SHORT_PENALTY_SHARE`] of the target, and is Newton's failure
+/// otherwise, as the stall was before. The same on every rank (the state is whole on each).
+fn penalty_judged(ctx: &Context, setup: &Setup, target: f64, solved: Result<EhlSolution, Error>) -> Result<EhlSolution, Error> {
+    let sol = solved?;
+    let Some(staged) = sol.penalty.as_ref().filter(|p| p.short()) else { return Ok(sol) };
+    let st = FieldsOnFace::new(&setup.mesh, &setup.layout, &sol.x).stats();
+    let Some(e) = penalty_of(setup, &sol, [st.hc, st.hm]) else { return Ok(sol) };
+    let what = format!(
+        "the cavitation penalty's ramp stalled at xi = {:.3e} of the scene's {:e}, where its estimated error is hc {:.3} %, hm {:.3} %",
+        staged.xi,
+        staged.scene_xi,
+        100.0 * e.hc,
+        100.0 * e.hm
+    );
+    if e.hc.max(e.hm) <= SHORT_PENALTY_SHARE * target {
+        ctx.log(format!("accuracy: {what}: within {SHORT_PENALTY_SHARE} of the target {target}, so the state there is kept and that error is part of the estimate"));
+        Ok(sol)
+    } else {
+        Err(Error::not_converged(format!(
+            "Newton did not converge: {what}, more than {SHORT_PENALTY_SHARE} of the target {target}; path: {}",
+            sol.steps.join("; ")
+        )))
+    }
 }
 
 /// Why `e` stopped Newton, without the path of solves it lists, for the log.
@@ -765,6 +836,7 @@ fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Le
     // The scene written with the result is the one its level was solved with.
     let mut scene = scene.clone();
     scene.reynolds.gradient_jump = done.gradient_jump;
+    scene.reynolds.penalty = done.penalty;
     let scene = &scene;
     let point = ctx.write_results(|dir| {
         let point = post_point(ctx, scene, &done.setup, &done.sol, done.condensation_s, done.friction.clone(), dir)?;
@@ -800,7 +872,7 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
     let mut report = json!({
         "target": target,
         "reached": shortfall.is_none(),
-        "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change",
+        "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change; hc and hm add the cavitation penalty's own error, from the films at the staged penalty xi = 1e3, the geometric mean of it and the level's xi, and the level's, converging like xi^(-p) with the p they show (0.1 to 1)",
         "levels": levels.iter().enumerate().map(|(k, l)| {
             let mut v = json!({
                 "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
@@ -819,6 +891,9 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
             if let Some(c) = l.cut {
                 v["budget_share"] = json!(c.share);
                 v["cut_by"] = json!(c.by.key());
+            }
+            if let Some(p) = l.penalty {
+                v["penalty"] = p.json();
             }
             v
         }).collect::<Vec<_>>(),

@@ -6,6 +6,10 @@
 //! before it (1/64 on a level made by quartering) is a crossing of the limit, not
 //! convergence ([`estimate_scaled`]). A level cut
 //! to the unknowns budget carries the estimate before it over ([`estimate_after_cut`]).
+//!
+//! To the change-based estimate of hc and hm is added the cavitation penalty's own error,
+//! where the penalty was staged ([`penalty_error`]): the discretisation's estimate does not
+//! see it, since every level has it.
 use super::adapt::Level;
 use serde_json::json;
 
@@ -25,14 +29,136 @@ const FASTEST_CONTRACTION: f64 = 0.125;
 /// Doerfler marking of its own, not part of one.
 pub const FULL_LEVEL_SHARE: f64 = 0.9;
 
+/// The slowest order in the cavitation penalty xi the penalty's estimate assumes: the films'
+/// error falls like xi^(-p), and p is measured on every level from three penalties
+/// ([`penalty_error`]); with two, or changes that do not shrink, p is this. The slowest
+/// measured was 0.16 per decade (hm at M = 500, L = 8 on a 0.125 a mesh, xi = 1e3, 1e4,
+/// 1e5); M = 10, L = 6 showed 0.44 (docs/accuracy.md, "The cavitation penalty's own error").
+pub const SLOWEST_PENALTY_ORDER: f64 = 0.1;
+
+/// The fastest order the estimate assumes: a cavitated nodal pressure's own, -O(1/xi)
+/// (`reynolds::cavitation`); a faster observed contraction is a crossing by chance.
+pub const FASTEST_PENALTY_ORDER: f64 = 1.0;
+
+/// A level whose staged penalty stalled is kept at the xi it reached only when its
+/// estimated penalty error is at most this share of the target: the discretisation's
+/// share of the estimate needs the rest.
+pub const SHORT_PENALTY_SHARE: f64 = 0.5;
+
+/// A level whose penalty part of the estimate is above this share of the target has the
+/// penalty raised tenfold for the levels after it ([`raised_penalty`]): refining the mesh
+/// does not take that part down.
+pub const PENALTY_RAISE_SHARE: f64 = 0.25;
+
+/// The largest cavitation penalty the adaptive loop raises a scene's to (three decades above
+/// the default 1e4).
+pub const MAX_RAISED_PENALTY: f64 = 1e7;
+
+/// The cavitation penalty for the levels after one whose penalty error is `p`, when it is to
+/// be raised: ten times the level's xi while the penalty's part is above
+/// [`PENALTY_RAISE_SHARE`] of `target`, up to [`MAX_RAISED_PENALTY`]. Not after a level
+/// whose ramp stalled short of its xi: a larger one would stall sooner.
+pub fn raised_penalty(p: &PenaltyError, target: f64) -> Option<f64> {
+    let raised = 10.0 * p.scene_xi;
+    (p.xi >= p.scene_xi && p.hc.max(p.hm) > PENALTY_RAISE_SHARE * target && raised <= MAX_RAISED_PENALTY).then_some(raised)
+}
+
+/// The estimated relative error left at the last penalty of a film with values `qs` at the
+/// ascending penalties `xis` (two or three, the same mesh), for q(xi) = q_inf + c xi^(-p):
+/// with c (x1^-p - x2^-p) the last change, the error at x2 is that change times
+/// x2^-p / (x1^-p - x2^-p). p is the order the last three values show
+/// ([`observed_penalty_order`]), or [`SLOWEST_PENALTY_ORDER`] with two. With three, the
+/// estimate is at least what the first change leaves at the fastest order: a last change
+/// that is small by chance does not make it vanish.
+pub fn penalty_error(qs: &[f64], xis: &[f64]) -> f64 {
+    let n = qs.len().min(xis.len());
+    if n < 2 || xis[n - 1] <= xis[n - 2] || qs[n - 1] == 0.0 {
+        return 0.0;
+    }
+    let left = |d: f64, x1: f64, x2: f64, p: f64| d.abs() * x2.powf(-p) / (x1.powf(-p) - x2.powf(-p));
+    let (x1, x2) = (xis[n - 2], xis[n - 1]);
+    let d = qs[n - 1] - qs[n - 2];
+    let mut e = if n >= 3 {
+        let p = observed_penalty_order(&qs[n - 3..n], &xis[n - 3..n]);
+        let x0 = xis[n - 3];
+        let guard = left(qs[n - 2] - qs[n - 3], x0, x1, FASTEST_PENALTY_ORDER) * x2.powf(-1.0) / x1.powf(-1.0);
+        left(d, x1, x2, p).max(guard)
+    } else {
+        left(d, x1, x2, SLOWEST_PENALTY_ORDER)
+    };
+    e /= qs[n - 1].abs();
+    if e.is_finite() {
+        e
+    } else {
+        0.0
+    }
+}
+
+/// The order p in xi that three values `qs` at penalties `xis` show, within
+/// [[`SLOWEST_PENALTY_ORDER`], [`FASTEST_PENALTY_ORDER`]]: the p at which
+/// (x1^-p - x2^-p)/(x0^-p - x1^-p), which falls as p grows, is the ratio of the two changes
+/// (bisection). Changes of opposite signs, or a first change of zero, are no sequence of
+/// that kind: the slowest order.
+pub fn observed_penalty_order(qs: &[f64], xis: &[f64]) -> f64 {
+    let (d1, d2) = (qs[1] - qs[0], qs[2] - qs[1]);
+    if d1 == 0.0 || d1 * d2 < 0.0 {
+        return SLOWEST_PENALTY_ORDER;
+    }
+    let ratio = (d2 / d1).abs();
+    let f = |p: f64| (xis[1].powf(-p) - xis[2].powf(-p)) / (xis[0].powf(-p) - xis[1].powf(-p));
+    let (mut lo, mut hi) = (SLOWEST_PENALTY_ORDER, FASTEST_PENALTY_ORDER);
+    if ratio >= f(lo) {
+        return lo;
+    }
+    if ratio <= f(hi) {
+        return hi;
+    }
+    for _ in 0..60 {
+        let m = 0.5 * (lo + hi);
+        if f(m) > ratio {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The cavitation penalty of a level: the xi it was solved at (below the scene's when its
+/// ramp stalled, [`SHORT_PENALTY_SHARE`]), the scene's, and the estimated relative errors
+/// of hc and hm it leaves ([`penalty_error`] from the state at the staged `base_xi`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PenaltyError {
+    pub xi: f64,
+    pub scene_xi: f64,
+    pub hc: f64,
+    pub hm: f64,
+}
+
+impl PenaltyError {
+    /// From the films hc, hm (any common unit) at the ascending penalties `xis` of one level,
+    /// the last the one it was solved at, and the scene's `scene_xi`.
+    pub fn of(xis: &[f64], films: &[[f64; 2]], scene_xi: f64) -> PenaltyError {
+        let e = |i: usize| penalty_error(&films.iter().map(|f| f[i]).collect::<Vec<_>>(), xis);
+        PenaltyError { xi: xis.last().copied().unwrap_or(scene_xi), scene_xi, hc: e(0), hm: e(1) }
+    }
+
+    pub(super) fn json(&self) -> serde_json::Value {
+        json!({ "xi": self.xi, "scene_xi": self.scene_xi, "estimated_error": { "hc": self.hc, "hm": self.hm } })
+    }
+}
+
 /// The estimated relative errors of a level's target quantities: hc and hm, and with
 /// friction fx and fz, each relative to the magnitude of the friction coefficient
 /// sqrt(fx^2 + fz^2) (fz vanishes by symmetry without spin, so its own size is no scale).
+/// hc and hm include the cavitation penalty's part, `penalty`, where it is estimated.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
     pub hc: f64,
     pub hm: f64,
     pub friction: Option<[f64; 2]>,
+    /// The cavitation penalty's part of hc and hm.
+    pub penalty: Option<[f64; 2]>,
 }
 
 impl Estimate {
@@ -47,7 +173,9 @@ impl Estimate {
             .iter()
             .map(|(q, scale)| if cut { estimate_after_cut(q, &halvings, *scale) } else { estimate_scaled(q, &halvings, *scale) })
             .collect::<Option<Vec<f64>>>()?;
-        Some(Estimate { hc: e[0], hm: e[1], friction: (e.len() == 4).then(|| [e[2], e[3]]) })
+        let penalty = levels.last().and_then(|l| l.penalty).map(|p| [p.hc, p.hm]);
+        let [pc, pm] = penalty.unwrap_or_default();
+        Some(Estimate { hc: e[0] + pc, hm: e[1] + pm, friction: (e.len() == 4).then(|| [e[2], e[3]]), penalty })
     }
 
     /// Whether a level cut to the budget after the last of `levels` could bring every
@@ -55,7 +183,11 @@ impl Estimate {
     /// cases/hard/spin-0.33deg it cost 800 s and moved fx's estimate from 1.31 % to 1.29 %).
     pub(super) fn cut_could_reach(levels: &[Level], target: f64) -> bool {
         let halvings = halvings(levels);
-        sequences(levels).iter().all(|(q, scale)| least_after_cut(q, &halvings, *scale).is_some_and(|e| e < target))
+        let penalty = levels.last().and_then(|l| l.penalty).map_or([0.0; 2], |p| [p.hc, p.hm]);
+        sequences(levels)
+            .iter()
+            .enumerate()
+            .all(|(i, (q, scale))| least_after_cut(q, &halvings, *scale).is_some_and(|e| e + penalty.get(i).unwrap_or(&0.0) < target))
     }
 
     /// Every estimated error.
@@ -70,6 +202,9 @@ impl Estimate {
         let mut s = format!("hc {:.2} %, hm {:.2} %", 100.0 * self.hc, 100.0 * self.hm);
         if let Some([fx, fz]) = self.friction {
             s.push_str(&format!(", fx {:.2} %, fz {:.2} %", 100.0 * fx, 100.0 * fz));
+        }
+        if let Some([pc, pm]) = self.penalty {
+            s.push_str(&format!(" (the cavitation penalty's part: hc {:.3} %, hm {:.3} %)", 100.0 * pc, 100.0 * pm));
         }
         s
     }
@@ -219,7 +354,65 @@ mod tests {
             est: None,
             cut: None,
             halvings: 1,
+            penalty: None,
         }
+    }
+
+    #[test]
+    fn the_penalty_error_finds_the_order_of_films_that_converge_in_xi() {
+        // q(xi) = 0.3 + 0.02 xi^(-p) at 1e3, 10^3.5, 1e4: the order is found and the error
+        // left at 1e4 is exact, for the orders measured (0.16, 0.44) and 1/xi.
+        for p in [0.16, 0.44, 1.0] {
+            let q = |xi: f64| 0.3 + 0.02 * xi.powf(-p);
+            let xis = [1e3, 10f64.powf(3.5), 1e4];
+            let qs: Vec<f64> = xis.iter().map(|&x| q(x)).collect();
+            assert!((observed_penalty_order(&qs, &xis) - p).abs() < 1e-9, "order {p}");
+            let exact = 0.02 * f64::powf(1e4, -p) / q(1e4);
+            let e = penalty_error(&qs, &xis);
+            assert!((e / exact - 1.0).abs() < 1e-6, "order {p}: {e} against {exact}");
+        }
+        // Unequal steps (a ramp kept short of the scene's xi, at 2.4e3).
+        let q = |xi: f64| 0.3 - 0.01 * xi.powf(-0.3);
+        let xis = [1e3, 1.7e3, 2.4e3];
+        let qs: Vec<f64> = xis.iter().map(|&x| q(x)).collect();
+        let exact = 0.01 * f64::powf(2.4e3, -0.3) / q(2.4e3);
+        assert!((penalty_error(&qs, &xis) / exact - 1.0).abs() < 1e-6);
+        // Two penalties: the slowest order, an overestimate of faster films.
+        let q = |xi: f64| 0.3 + 0.02 * xi.powf(-0.44);
+        let e = penalty_error(&[q(1e3), q(1e4)], &[1e3, 1e4]);
+        assert!(e > 0.02 * f64::powf(1e4, -0.44) / q(1e4));
+        // Changes that do not shrink or change sign: the slowest order.
+        assert_eq!(observed_penalty_order(&[1.0, 1.1, 1.3], &[1e3, 3e3, 1e4]), SLOWEST_PENALTY_ORDER);
+        assert_eq!(observed_penalty_order(&[1.0, 1.1, 1.05], &[1e3, 3e3, 1e4]), SLOWEST_PENALTY_ORDER);
+        // A last change of zero by chance: the first change at the fastest order remains.
+        assert!(penalty_error(&[1.0, 1.001, 1.001], &[1e3, 3e3, 1e4]) > 1e-4);
+        // One penalty: nothing to estimate.
+        assert_eq!(penalty_error(&[0.3], &[1e4]), 0.0);
+    }
+
+    #[test]
+    fn the_penalty_is_raised_while_its_part_is_above_a_quarter_of_the_target() {
+        let at = |xi: f64, hm: f64| PenaltyError { xi, scene_xi: 1e4, hc: 1e-5, hm };
+        assert_eq!(raised_penalty(&at(1e4, 7.5e-4), 0.001), Some(1e5));
+        // A quarter of the target or less, or a ramp that stalled short of its xi: kept.
+        assert_eq!(raised_penalty(&at(1e4, 2.5e-4), 0.001), None);
+        assert_eq!(raised_penalty(&at(2.4e3, 2.4e-3), 0.001), None);
+        // Not beyond the largest raised penalty.
+        let top = PenaltyError { xi: MAX_RAISED_PENALTY, scene_xi: MAX_RAISED_PENALTY, hc: 0.0, hm: 1e-3 };
+        assert_eq!(raised_penalty(&top, 0.001), None);
+    }
+
+    #[test]
+    fn the_penalty_part_adds_to_the_films_estimates_only() {
+        let mut levels: Vec<Level> =
+            [(1.05, 0.52), (1.02, 0.51), (1.01, 0.505)].iter().map(|&(c, m)| level(c, m, Some([0.05, 0.0]))).collect();
+        let without = Estimate::of(&levels).unwrap();
+        levels[2].penalty = Some(PenaltyError { xi: 1e4, scene_xi: 1e4, hc: 1e-4, hm: 5e-4 });
+        let with = Estimate::of(&levels).unwrap();
+        assert!((with.hc - without.hc - 1e-4).abs() < 1e-15 && (with.hm - without.hm - 5e-4).abs() < 1e-15);
+        assert_eq!(with.friction, without.friction);
+        assert_eq!(with.penalty, Some([1e-4, 5e-4]));
+        assert!(with.describe().contains("penalty's part: hc 0.010 %, hm 0.050 %"), "{}", with.describe());
     }
 
     #[test]

@@ -34,8 +34,8 @@ use crate::mesh::{Mesh, Partition};
 use crate::petsc::snes::SolveReport;
 use crate::petsc::{self, Matrix};
 use crate::solid::{assembly, dofmap::DofMap};
-pub use continuation::ContinuationPath;
 use continuation::{newton_with_continuation, MilderStart};
+pub use continuation::{ContinuationPath, StagedPenalty};
 use policy::Policy;
 use problem::ehl_params;
 use start::{coarser_displacement, elastic_start, rigid_start, start_h0};
@@ -57,6 +57,9 @@ pub struct EhlSolution {
     /// The path of the continuation that found the state (monolithic layout). A finer
     /// level starts its continuation there ([`Milder`]).
     pub milder: Option<ContinuationPath>,
+    /// The staged cavitation penalty's state at xi = 1e3 (monolithic layout) and the xi the
+    /// solution is at, when the penalty was staged.
+    pub penalty: Option<StagedPenalty>,
 }
 
 /// The lubricated solver of one mesh: the parts that do not depend on the operating
@@ -79,6 +82,8 @@ pub struct EhlSolver<'a> {
     /// Keep the last monolithic Newton solver for [`EhlSolver::adjoint`] ([`EhlSolver::keep_newton`]).
     keep: bool,
     kept: std::cell::RefCell<Option<Kept<'a>>>,
+    /// A staged penalty's stalled ramp keeps its state ([`EhlSolver::accept_short_penalty`]).
+    short_penalty: bool,
 }
 
 /// A converged monolithic solve's Newton solver, its Jacobian matrix and its system (with
@@ -145,7 +150,19 @@ impl<'a> EhlSolver<'a> {
         };
         let condensation_s = (!rigid && !monolithic).then(|| t0.elapsed().as_secs_f64());
         crate::interrupt::check("the elastic condensation")?;
-        Ok(EhlSolver { mesh, part, dofs, layout, half, coupling, comp, condensation_s, keep: false, kept: Default::default() })
+        Ok(EhlSolver {
+            mesh,
+            part,
+            dofs,
+            layout,
+            half,
+            coupling,
+            comp,
+            condensation_s,
+            keep: false,
+            kept: Default::default(),
+            short_penalty: false,
+        })
     }
 
     /// Keep the Newton solver of each converged monolithic solve until the next solve or
@@ -153,6 +170,14 @@ impl<'a> EhlSolver<'a> {
     /// per level; the factorisation's memory stays in use meanwhile). Off by default.
     pub fn keep_newton(&mut self, yes: bool) {
         self.keep = yes;
+    }
+
+    /// A staged cavitation penalty whose ramp stalls above xi = 1e3 returns the state it
+    /// converged at (solved to the scene's tolerance) instead of failing, with
+    /// [`EhlSolution::penalty`] saying how far it got: for a caller that estimates the
+    /// penalty's error and judges it against an accuracy target. Off by default.
+    pub fn accept_short_penalty(&mut self, yes: bool) {
+        self.short_penalty = yes;
     }
 
     /// Releases a kept Newton solver (its factorisation's memory), if any.
@@ -182,14 +207,15 @@ impl<'a> EhlSolver<'a> {
         self.release_newton();
         let once = |start: Start, attempt: Attempt| match &self.comp {
             None => {
-                solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, attempt).map(|(s, kept)| {
-                    if self.keep {
-                        *self.kept.borrow_mut() = Some(kept);
-                    }
-                    s
-                })
+                solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, attempt, self.short_penalty)
+                    .map(|(s, kept)| {
+                        if self.keep {
+                            *self.kept.borrow_mut() = Some(kept);
+                        }
+                        s
+                    })
             }
-            Some(comp) => solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, start, attempt),
+            Some(comp) => solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, start, attempt, self.short_penalty),
         };
         if !matches!(start, Start::Hertz) {
             let ladder = Attempt::ladder(&start, self.comp.is_none());
@@ -241,6 +267,7 @@ fn solve_condensed(
     half: bool,
     start: Start,
     attempt: Attempt,
+    short_penalty: bool,
 ) -> Result<EhlSolution, Error> {
     let eq = scene.equivalent_solid();
     let t0 = std::time::Instant::now();
@@ -288,7 +315,7 @@ fn solve_condensed(
         cl.n_p,
         if comp.is_rigid() { "sparse" } else { "dense" }
     ));
-    let policy = Policy::for_start(&start, attempt);
+    let policy = Policy { accepts_short_penalty: short_penalty, ..Policy::for_start(&start, attempt) };
     let milder = match start.milder().filter(|_| policy.continues) {
         Some(m) => Some((m, state_of(&system, m.p, m.hc)?)),
         None => None,
@@ -331,6 +358,8 @@ fn solve_condensed(
     })?;
     let x = monolithic(&out.x);
     let milder = out.milder.map(|path| ContinuationPath { x: monolithic(&path.x), ..path });
+    let penalty =
+        out.penalty.map(|st| StagedPenalty { base_x: monolithic(&st.base_x), mid: st.mid.map(|(xi, x)| (xi, monolithic(&x))), ..st });
     let coupling = if comp.is_rigid() { Coupling::Rigid } else { Coupling::Condensed };
     Ok(EhlSolution {
         x,
@@ -342,6 +371,7 @@ fn solve_condensed(
         coupling,
         continued: out.continued,
         milder,
+        penalty,
     })
 }
 
@@ -388,6 +418,7 @@ fn solve_monolithic<'a>(
     half: bool,
     start: Start,
     attempt: Attempt,
+    short_penalty: bool,
 ) -> Result<(EhlSolution, Kept<'a>), Error> {
     let comm = petsc::comm_world();
     let eq = scene.equivalent_solid();
@@ -435,7 +466,7 @@ fn solve_monolithic<'a>(
             state_of(p, hc, start.coarser().and_then(|c| coarser_displacement(&c, mesh)))?
         }
     };
-    let policy = Policy::for_start(&start, attempt);
+    let policy = Policy { accepts_short_penalty: short_penalty, ..Policy::for_start(&start, attempt) };
     let milder = match start.milder().filter(|_| policy.continues) {
         Some(m) => Some((m, state_of(m.p, m.hc, None)?)),
         None => None,
@@ -485,6 +516,7 @@ fn solve_monolithic<'a>(
         coupling: Coupling::Monolithic,
         continued: out.continued,
         milder: out.milder,
+        penalty: out.penalty,
     };
     Ok((solution, Kept { snes: out.snes, jacobian: j, system }))
 }

@@ -95,6 +95,11 @@ pub(super) struct Policy {
     pub(super) ramp: super::start::RampLimits,
     /// The start is the Hertz start (some continuations are no milder problem from there).
     pub(super) from_hertz: bool,
+    /// A staged penalty whose ramp stalls above xi = 1e3 keeps the state it converged at
+    /// (solved again to the scene's tolerance) instead of failing: the caller estimates the
+    /// penalty's error from the two states and decides ([`super::StagedPenalty`]). Off
+    /// unless the solver is told ([`super::EhlSolver::accept_short_penalty`]).
+    pub(super) accepts_short_penalty: bool,
 }
 
 impl Policy {
@@ -129,6 +134,7 @@ impl Policy {
             last_resorts: start.last_resorts(),
             ramp: start.ramp(),
             from_hertz: hertz,
+            accepts_short_penalty: false,
         }
     }
 }
