@@ -833,7 +833,7 @@ pub(super) fn newton_with_continuation(
         } else {
             None
         };
-        let mid = nw.trail.take().unwrap_or_default().into_iter().filter(|(s, _)| *s < t).next_back().map(|(s, x)| (xi * s, x));
+        let mid = nw.trail.take().unwrap_or_default().into_iter().rfind(|(s, _)| *s < t).map(|(s, x)| (xi * s, x));
         staged_penalty = Some(StagedPenalty { base_xi: PENALTY_START, base_x: from, mid, xi: xi * t, scene_xi: xi });
     }
     let (Some(xs), Some(last)) = (state, last.as_ref()) else {
