@@ -785,27 +785,15 @@ pub(super) fn newton_with_continuation(
     if let Some(from) = state.take_if(|_| staged) {
         let first = PENALTY_START / xi;
         let h = Homotopy { parameter: Parameter::Penalty(xi), ramp: Ramp { first, lowest: first, ratio: xi / PENALTY_START } };
-        // For a caller that estimates the penalty's error the ramp passes through the
-        // geometric mean of 1e3 and xi and keeps the states it converges at: three films
-        // show the order at which they converge in xi, which varies between scenes (0.16 to
-        // 0.44 per decade for hm, docs/accuracy.md). A failed middle step leaves the ramp
-        // at a quarter of the decades per step.
-        let (mut t0, mut ratio, mut start) = (first, h.ramp.ratio, from.clone());
+        // For a caller that estimates the penalty's error the states the ramp converges at
+        // on the way are kept: with a stalled ramp, its last two and the one at 1e3 show
+        // the order at which the films converge in xi (docs/accuracy.md).
         if policy.accepts_short_penalty {
             nw.trail = Some(Vec::new());
-            let half = first.sqrt();
-            let (r, xm) = nw.solve_at(scene, h.parameter, (first, half), system, &from, "")?;
-            last = Some(r);
-            match xm {
-                Some(xm) => {
-                    (t0, ratio) = (half, 1.0 / half);
-                    nw.trail.get_or_insert_with(Vec::new).push((half, xm.clone()));
-                    start = xm;
-                }
-                None => ratio = (half / first).sqrt(),
-            }
         }
-        let (done, r, xs, below) = nw.ramp(scene, &h, t0, start, system, RampSteps::new(ratio, &[], RampLimits::DEFAULT))?;
+        let t0 = first;
+        let (done, r, xs, below) =
+            nw.ramp(scene, &h, first, from.clone(), system, RampSteps::new(h.ramp.ratio, &[], RampLimits::DEFAULT))?;
         if r.is_some() {
             last = r;
         }
