@@ -780,7 +780,7 @@ pub(super) fn newton_with_continuation(
     //    short of the scene's: then the state it converged at is solved to the scene's
     //    tolerance and kept. At M = 10, L = 20 on a 0.0625 a level every try stalled
     //    between xi = 2.4e3 and 3e3, cycling on a one-element outlet spike, while the films
-    //    moved by 0.1 % between 1e3 and 2.4e3 (docs/accuracy.md, "The penalty's own error").
+    //    moved by 0.1 % between 1e3 and 2.4e3 (docs/accuracy.md, "A penalty ramp that stalls").
     let mut staged_penalty = None;
     if let Some(from) = state.take_if(|_| staged) {
         let first = PENALTY_START / xi;
@@ -791,13 +791,12 @@ pub(super) fn newton_with_continuation(
         if policy.accepts_short_penalty {
             nw.trail = Some(Vec::new());
         }
-        let t0 = first;
         let (done, r, xs, below) =
             nw.ramp(scene, &h, first, from.clone(), system, RampSteps::new(h.ramp.ratio, &[], RampLimits::DEFAULT))?;
         if r.is_some() {
             last = r;
         }
-        let t = if done { 1.0 } else { below.last().copied().unwrap_or(t0) };
+        let t = if done { 1.0 } else { below.last().copied().unwrap_or(first) };
         state = if done {
             Some(xs)
         } else if policy.accepts_short_penalty && t > first {
