@@ -567,8 +567,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             crate::interrupt::set_deadline(Some(ctx.start + std::time::Duration::from_secs_f64(acc.max_seconds)));
         }
         let mut est = Estimate::of(&levels);
-        // The penalty's part from two films (1e3 and the level's xi) assumes the slowest order.
-        // Where that part is what keeps the level from the target or would raise the penalty,
+        // The penalty's part from two films (1e3 and the level's xi) assumes the order 1/4
+        // (`estimate::TWO_FILM_PENALTY_ORDER`). Where that part is what keeps the level from
+        // the target or would raise the penalty,
         // a third film at the geometric mean of the two penalties, solved by plain Newton
         // from the level's state, measures the order instead. Stepping through that penalty
         // on every level cost 20-35 % of a level's time (M = 500, L = 8: 79 s against 58 s).
