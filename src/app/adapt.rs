@@ -569,10 +569,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let mut est = Estimate::of(&levels);
         // The penalty's part from two films (1e3 and the level's xi) assumes the order 1/4
         // (`estimate::TWO_FILM_PENALTY_ORDER`). Where that part is what keeps the level from
-        // the target or would raise the penalty,
-        // a third film at the geometric mean of the two penalties, solved by plain Newton
-        // from the level's state, measures the order instead. Stepping through that penalty
-        // on every level cost 20-35 % of a level's time (M = 500, L = 8: 79 s against 58 s).
+        // the target or would raise the penalty, a third film at the geometric mean of the
+        // two penalties, solved by plain Newton from the level's state, measures the order
+        // instead. Stepping through that penalty on every level cost 20-35 % of a level's
+        // time (M = 500, L = 8: 79 s against 58 s).
         if let Some(xi) = est.as_ref().and_then(|e| third_penalty(&sol, levels.last().and_then(|l| l.penalty), e, target)) {
             let t = Instant::now();
             let mut at = scene.clone();
@@ -619,7 +619,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             level.hm_at[1],
             level.pmax,
             level.friction.map_or(String::new(), |f| format!(", fx = {:.5e}, fz = {:.5e}", f[0], f[1])),
-            level.penalty.filter(|p| p.xi < p.scene_xi).map_or(String::new(), |p| format!(" (cavitation penalty xi = {:.3e}, short of the scene's {:e})", p.xi, p.scene_xi)),
+            level.penalty.filter(|p| p.short()).map_or(String::new(), |p| format!(" (cavitation penalty xi = {:.3e}, short of the scene's {:e})", p.xi, p.scene_xi)),
             level.est.map_or("- (first level)".to_string(), |e| e.describe())
         ));
         let reached = k >= 2 && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
@@ -717,8 +717,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // penalty part above a quarter of it, once the mesh's part is below it, raises the
         // penalty tenfold for the levels after (docs/accuracy.md, "The cavitation penalty's
         // own error").
-        if let Some(xi) = levels.last().and_then(|l| l.penalty.and_then(|p| raised_penalty(&p, l.est.as_ref(), target))) {
-            let p = levels.last().and_then(|l| l.penalty).expect("the level's penalty");
+        let raise = levels.last().and_then(|l| l.penalty.and_then(|p| raised_penalty(&p, l.est.as_ref(), target).map(|xi| (p, xi))));
+        if let Some((p, xi)) = raise {
             ctx.log(format!(
                 "accuracy: the cavitation penalty's part of the estimate (hc {:.3} %, hm {:.3} %) is above a quarter of the target, the mesh's part below it; reynolds.penalty raised from {:e} to {xi:e} for the levels after level {k}",
                 100.0 * p.hc,
@@ -763,7 +763,7 @@ fn closed_at_spin_pole(e: &Error) -> bool {
 fn third_penalty(sol: &EhlSolution, p: Option<PenaltyError>, est: &Estimate, target: f64) -> Option<f64> {
     let staged = sol.penalty.as_ref().filter(|s| s.mid.is_none() && s.xi > s.base_xi)?;
     let p = p?;
-    let mesh = (est.hc - p.hc).max(est.hm - p.hm);
+    let mesh = est.films_mesh_part();
     let decides = est.hc.max(est.hm) >= target || p.hc.max(p.hm) > super::estimate::PENALTY_RAISE_SHARE * target;
     (mesh < target && decides).then(|| (staged.base_xi * staged.xi).sqrt())
 }

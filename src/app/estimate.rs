@@ -72,8 +72,8 @@ pub const MAX_RAISED_PENALTY: f64 = 1e7;
 /// stall sooner.
 pub fn raised_penalty(p: &PenaltyError, est: Option<&Estimate>, target: f64) -> Option<f64> {
     let raised = 10.0 * p.scene_xi;
-    let mesh_within = est.is_some_and(|e| (e.hc - p.hc).max(e.hm - p.hm) < target);
-    (mesh_within && p.xi >= p.scene_xi && p.hc.max(p.hm) > PENALTY_RAISE_SHARE * target && raised <= MAX_RAISED_PENALTY).then_some(raised)
+    let mesh_within = est.is_some_and(|e| e.films_mesh_part() < target);
+    (mesh_within && !p.short() && p.hc.max(p.hm) > PENALTY_RAISE_SHARE * target && raised <= MAX_RAISED_PENALTY).then_some(raised)
 }
 
 /// The estimated relative error left at the last penalty of a film with values `qs` at the
@@ -94,7 +94,8 @@ pub fn penalty_error(qs: &[f64], xis: &[f64]) -> f64 {
     let mut e = if n >= 3 {
         let p = observed_penalty_order(&qs[n - 3..n], &xis[n - 3..n]);
         let x0 = xis[n - 3];
-        let guard = left(qs[n - 2] - qs[n - 3], x0, x1, FASTEST_PENALTY_ORDER) * x2.powf(-1.0) / x1.powf(-1.0);
+        // The first change's error left at x1 at order 1, carried to x2 (times x1/x2).
+        let guard = left(qs[n - 2] - qs[n - 3], x0, x1, FASTEST_PENALTY_ORDER) * x1 / x2;
         left(d, x1, x2, p).max(guard)
     } else {
         left(d, x1, x2, TWO_FILM_PENALTY_ORDER)
@@ -156,6 +157,11 @@ impl PenaltyError {
         PenaltyError { xi: xis.last().copied().unwrap_or(scene_xi), scene_xi, hc: e(0), hm: e(1) }
     }
 
+    /// The level was solved at a penalty below the scene's (its ramp stalled).
+    pub fn short(&self) -> bool {
+        self.xi < self.scene_xi
+    }
+
     pub(super) fn json(&self) -> serde_json::Value {
         json!({ "xi": self.xi, "scene_xi": self.scene_xi, "estimated_error": { "hc": self.hc, "hm": self.hm } })
     }
@@ -201,6 +207,12 @@ impl Estimate {
             .iter()
             .enumerate()
             .all(|(i, (q, scale))| least_after_cut(q, &halvings, *scale).is_some_and(|e| e + penalty.get(i).unwrap_or(&0.0) < target))
+    }
+
+    /// The larger of hc's and hm's estimates less the cavitation penalty's part: the mesh's.
+    pub(super) fn films_mesh_part(&self) -> f64 {
+        let [pc, pm] = self.penalty.unwrap_or_default();
+        (self.hc - pc).max(self.hm - pm)
     }
 
     /// Every estimated error.

@@ -68,7 +68,8 @@ pub(super) struct NewtonOutcome {
     /// The solver of the last Newton solve, with the factorisation it last made: the
     /// monolithic adjoint solves on it ([`super::Kept`]).
     pub(super) snes: Snes,
-    /// The staged cavitation penalty's two states, when it was staged.
+    /// The staged cavitation penalty's states, when it was staged for a caller that
+    /// estimates its error ([`Policy::accepts_short_penalty`]).
     pub(super) penalty: Option<StagedPenalty>,
 }
 
@@ -791,8 +792,9 @@ pub(super) fn newton_with_continuation(
         if policy.accepts_short_penalty {
             nw.trail = Some(Vec::new());
         }
-        let (done, r, xs, below) =
-            nw.ramp(scene, &h, first, from.clone(), system, RampSteps::new(h.ramp.ratio, &[], RampLimits::DEFAULT))?;
+        // The state at 1e3 is kept only for a caller that estimates the penalty's error.
+        let base = policy.accepts_short_penalty.then(|| from.clone());
+        let (done, r, xs, below) = nw.ramp(scene, &h, first, from, system, RampSteps::new(h.ramp.ratio, &[], RampLimits::DEFAULT))?;
         if r.is_some() {
             last = r;
         }
@@ -820,8 +822,10 @@ pub(super) fn newton_with_continuation(
         } else {
             None
         };
-        let mid = nw.trail.take().unwrap_or_default().into_iter().rfind(|(s, _)| *s < t).map(|(s, x)| (xi * s, x));
-        staged_penalty = Some(StagedPenalty { base_xi: PENALTY_START, base_x: from, mid, xi: xi * t, scene_xi: xi });
+        staged_penalty = base.map(|base_x| {
+            let mid = nw.trail.take().unwrap_or_default().into_iter().rfind(|(s, _)| *s < t).map(|(s, x)| (xi * s, x));
+            StagedPenalty { base_xi: PENALTY_START, base_x, mid, xi: xi * t, scene_xi: xi }
+        });
     }
     let (Some(xs), Some(last)) = (state, last.as_ref()) else {
         let end = match &last {

@@ -58,7 +58,8 @@ pub struct EhlSolution {
     /// level starts its continuation there ([`Milder`]).
     pub milder: Option<ContinuationPath>,
     /// The staged cavitation penalty's state at xi = 1e3 (monolithic layout) and the xi the
-    /// solution is at, when the penalty was staged.
+    /// solution is at, when the penalty was staged for a solver told to accept a short one
+    /// ([`EhlSolver::accept_short_penalty`]).
     pub penalty: Option<StagedPenalty>,
 }
 

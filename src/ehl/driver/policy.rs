@@ -95,10 +95,11 @@ pub(super) struct Policy {
     pub(super) ramp: super::start::RampLimits,
     /// The start is the Hertz start (some continuations are no milder problem from there).
     pub(super) from_hertz: bool,
-    /// A staged penalty whose ramp stalls above xi = 1e3 keeps the state it converged at
-    /// (solved again to the scene's tolerance) instead of failing: the caller estimates the
-    /// penalty's error from the two states and decides ([`super::StagedPenalty`]). Off
-    /// unless the solver is told ([`super::EhlSolver::accept_short_penalty`]).
+    /// The caller estimates a staged penalty's error: the solve returns its states
+    /// ([`super::StagedPenalty`]), and a ramp that stalls above xi = 1e3 keeps the state it
+    /// converged at (solved again to the scene's tolerance) instead of failing, for the
+    /// caller to judge. Off unless the solver is told
+    /// ([`super::EhlSolver::accept_short_penalty`]).
     pub(super) accepts_short_penalty: bool,
 }
 
