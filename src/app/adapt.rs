@@ -30,7 +30,7 @@
 //!    triangle at the smallest size), the
 //!    last level's result is written with its estimated error, `accuracy.reached` is
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
-use super::estimate::{raised_penalty, Estimate, PenaltyError, SHORT_PENALTY_SHARE};
+use super::estimate::{raised_penalty, Estimate, PenaltyError, PenaltySlopes, SHORT_PENALTY_SHARE};
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, PointResult, Setup};
 use super::marking::{
@@ -303,10 +303,11 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
         };
         // The adjoint after the level solves on Newton's last factorisation.
-        solver.keep_newton(acc.marking > 0.0 || scene.output.speed_exponents);
+        let penalised = scene.effects.cavitation == crate::case::CavitationModel::Penalty;
+        solver.keep_newton(acc.marking > 0.0 || scene.output.speed_exponents || penalised);
         // A staged penalty that stalls short of the scene's is judged by its error here.
         solver.accept_short_penalty(true);
-        let mut sol = match (&previous, earlier) {
+        let sol = match (&previous, earlier) {
             (Some(prev), _) => {
                 let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
                 let p = |x: f64, z: f64| pf.at(x, z).map_or(0.0, |v| v.0);
@@ -558,7 +559,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             est: None,
             cut: cut.take(),
             halvings: if k == 0 { 1 } else { next.as_ref().map_or(1, |m| m.halvings) },
-            penalty: penalty_of(&setup, &sol, [st.hc, st.hm]),
+            penalty: penalty_of(&setup, &sol, [st.hc, st.hm], None, scene.reynolds.penalty),
         };
         over.clear();
         levels.push(level);
@@ -566,38 +567,38 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             // The budget covers the levels after the first: a run always has a result.
             crate::interrupt::set_deadline(Some(ctx.start + std::time::Duration::from_secs_f64(acc.max_seconds)));
         }
-        let mut est = Estimate::of(&levels);
-        // The penalty's part from two films (1e3 and the level's xi) assumes the order 1/4
-        // (`estimate::TWO_FILM_PENALTY_ORDER`). Where that part is what keeps the level from
-        // the target or would raise the penalty, a third film at the geometric mean of the
-        // two penalties, solved by plain Newton from the level's state, measures the order
-        // instead. Stepping through that penalty on every level cost 20-35 % of a level's
-        // time (M = 500, L = 8: 79 s against 58 s).
-        if let Some(xi) = est.as_ref().and_then(|e| third_penalty(&sol, levels.last().and_then(|l| l.penalty), e, target)) {
-            let t = Instant::now();
-            let mut at = scene.clone();
-            at.reynolds.penalty = xi;
-            match collective::agree(&ctx.world, solver.solve_near(ctx, &at, &sol.x)) {
-                Ok(m) => {
-                    if let Some(staged) = sol.penalty.as_mut() {
-                        staged.mid = Some((xi, m.x));
-                    }
-                    let level = levels.last_mut().expect("the level just pushed");
-                    level.penalty = penalty_of(&setup, &sol, [st.hc, st.hm]);
-                    level.newton_iterations += m.newton_total;
-                    est = Estimate::of(&levels);
-                    ctx.log(format!(
-                        "accuracy: the cavitation penalty's part measured with a third film at xi = {xi:.3e} ({} Newton its, {:.1} s)",
-                        m.newton_total,
-                        t.elapsed().as_secs_f64()
-                    ));
-                }
-                Err(e) if crate::interrupt::agreed() == 0 => {
-                    ctx.log(format!("accuracy: the cavitation penalty's third film at xi = {xi:.3e} did not converge ({}); the estimate from two films stands", reason(&e)));
-                }
-                Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
+        // A level cut to the budget is the last: the level after it would refine the rest of
+        // its marking and more, over the budget, and would not be cut again.
+        let cut_level = levels.last().is_some_and(|l| l.cut.is_some());
+        let may_go_on = k < max_levels && !cut_level;
+        // One adjoint LU serves the next level's marking, the speed exponents when asked for,
+        // and the values' slopes in the cavitation penalty, which estimate the penalty's own
+        // error: on every level that has an estimate (the second on), also the last, and on
+        // the first when it marks anyway.
+        let slopes_wanted = k >= 1 && penalised;
+        let goal = may_go_on && acc.marking > 0.0;
+        let mut adjoint = (goal || slopes_wanted || scene.output.speed_exponents)
+            .then(|| collective::agree(&ctx.world, solver.adjoint(ctx, scene, &sol.x)));
+        let goals_of = match &adjoint {
+            Some(Ok(a)) if goal || slopes_wanted => {
+                Some(collective::agree(&ctx.world, goals(ctx, scene, a, &fields, &st, friction.as_ref())))
             }
+            Some(Err(e)) => Some(Err(Error::numerical(format!("the adjoint failed: {e}")))),
+            _ => None,
+        };
+        if penalised && goals_of.is_some() {
+            let slopes = match (&mut adjoint, &goals_of) {
+                (Some(Ok(a)), Some(Ok(g))) => collective::agree(&ctx.world, super::sensitivity::penalty_slopes(a, g)),
+                (_, Some(Err(e))) => Err(Error::numerical(e.to_string())),
+                _ => Err(Error::numerical("no adjoint")),
+            };
+            let slopes = slopes
+                .map_err(|e| ctx.log(format!("accuracy: the films' slopes in the cavitation penalty were not computed ({e}); its part of the estimate is from the staged films alone, where there are two")))
+                .ok();
+            levels.last_mut().expect("the level just pushed").penalty =
+                penalty_of(&setup, &sol, [st.hc, st.hm], slopes, scene.reynolds.penalty);
         }
+        let est = Estimate::of(&levels);
         let level = levels.last_mut().expect("the level just pushed");
         level.est = est;
         ctx.log(format!(
@@ -623,14 +624,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             level.est.map_or("- (first level)".to_string(), |e| e.describe())
         ));
         let reached = k >= 2 && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
-        // A level cut to the budget is the last: the level after it would refine the rest of
-        // its marking and more, over the budget, and would not be cut again.
-        let cut_level = levels.last().is_some_and(|l| l.cut.is_some());
-        let last = reached || k == max_levels || cut_level;
-        // The next level's marking, while this level's fields are at hand (not when it is the
-        // last), and the speed exponents when asked for: both from one adjoint LU.
-        let goal = !last && acc.marking > 0.0;
-        let mut adjoint = (goal || scene.output.speed_exponents).then(|| collective::agree(&ctx.world, solver.adjoint(ctx, scene, &sol.x)));
+        let last = reached || !may_go_on;
         let exponents = match (&mut adjoint, scene.output.speed_exponents) {
             (Some(Ok(a)), true) => Some(collective::agree(&ctx.world, super::sensitivity::speed_exponents(ctx, a, &fields, &st))),
             (Some(Err(e)), true) => Some(Err(Error::numerical(format!("the adjoint failed: {e}")))),
@@ -640,25 +634,15 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let fz_target = friction.is_some() && !setup.half;
         let quarter = quarters(est.as_ref(), target, fz_target, sol.continued);
         let marked = if !last {
-            Some(match adjoint.as_ref().filter(|_| goal) {
-                // A failed adjoint costs this level's goal-oriented marking, not the run (an
-                // interruption is acted on at the check after the marking).
-                Some(Ok(a)) => {
-                    match collective::agree(&ctx.world, goals(ctx, scene, a, &fields, &st, friction.as_ref()))
-                        .map(|goals| goal_mark(ctx, scene, &fields, &goals, &edges, acc.marking, quarter))
-                    {
-                        Ok(m) => {
-                            zone_retry = Some(k + 1);
-                            m
-                        }
-                        Err(e) => {
-                            ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
-                            Marking::unranked(zone_mark(&fields, &edges))
-                        }
-                    }
+            // A failed adjoint or goal costs this level's goal-oriented marking, not the run
+            // (an interruption is acted on at the check after the marking).
+            Some(match goals_of.filter(|_| goal) {
+                Some(Ok(goals)) => {
+                    zone_retry = Some(k + 1);
+                    goal_mark(ctx, scene, &fields, &goals, &edges, acc.marking, quarter)
                 }
                 Some(Err(e)) => {
-                    ctx.log(format!("accuracy: the adjoint failed ({e}); level {} refines the pressurised zone", k + 1));
+                    ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
                     Marking::unranked(zone_mark(&fields, &edges))
                 }
                 None => Marking::unranked(zone_mark(&fields, &edges)),
@@ -755,27 +739,16 @@ fn closed_at_spin_pole(e: &Error) -> bool {
     newton_failure(e) && e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE)
 }
 
-/// The penalty at which a level's third film is solved ([`PenaltyError`] from three films
-/// instead of two), when the two films' estimate `p` decides: the mesh's part of `est` is
-/// below the target and the penalty's part takes the whole above it or would raise the
-/// penalty ([`raised_penalty`]). The geometric mean of the staged and the level's xi; None
-/// when the level has three films already (its ramp stalled on the way) or none.
-fn third_penalty(sol: &EhlSolution, p: Option<PenaltyError>, est: &Estimate, target: f64) -> Option<f64> {
-    let staged = sol.penalty.as_ref().filter(|s| s.mid.is_none() && s.xi > s.base_xi)?;
-    let p = p?;
-    let mesh = est.films_mesh_part();
-    let decides = est.hc.max(est.hm) >= target || p.hc.max(p.hm) > super::estimate::PENALTY_RAISE_SHARE * target;
-    (mesh < target && decides).then(|| (staged.base_xi * staged.xi).sqrt())
-}
-
 /// The cavitation penalty's estimated error on a level's films `films` (hc, hm), from its
-/// state at the staged penalty, when the penalty was staged.
-fn penalty_of(setup: &Setup, sol: &EhlSolution, films: [f64; 2]) -> Option<PenaltyError> {
-    let staged = sol.penalty.as_ref()?;
+/// state at the staged penalty where the penalty was staged, and from the values' slopes
+/// in xi where the adjoints gave them (`slopes`; a scene's penalty `scene_xi` that was not
+/// staged has them alone).
+fn penalty_of(setup: &Setup, sol: &EhlSolution, films: [f64; 2], slopes: Option<PenaltySlopes>, scene_xi: f64) -> Option<PenaltyError> {
     let film = |x: &[f64]| {
         let st = FieldsOnFace::new(&setup.mesh, &setup.layout, x).stats();
         [st.hc, st.hm]
     };
+    let Some(staged) = sol.penalty.as_ref() else { return PenaltyError::of(&[scene_xi], &[films], slopes, scene_xi) };
     let mut xis = vec![staged.base_xi];
     let mut at = vec![film(&staged.base_x)];
     if let Some((xi, x)) = staged.mid.as_ref().filter(|(xi, _)| *xi < staged.xi) {
@@ -784,7 +757,7 @@ fn penalty_of(setup: &Setup, sol: &EhlSolution, films: [f64; 2]) -> Option<Penal
     }
     xis.push(staged.xi);
     at.push(films);
-    Some(PenaltyError::of(&xis, &at, staged.scene_xi))
+    PenaltyError::of(&xis, &at, slopes, staged.scene_xi)
 }
 
 /// A solution whose staged cavitation penalty stalled short of the scene's
@@ -795,7 +768,7 @@ fn penalty_judged(ctx: &Context, setup: &Setup, target: f64, solved: Result<EhlS
     let sol = solved?;
     let Some(staged) = sol.penalty.as_ref().filter(|p| p.short()) else { return Ok(sol) };
     let st = FieldsOnFace::new(&setup.mesh, &setup.layout, &sol.x).stats();
-    let Some(e) = penalty_of(setup, &sol, [st.hc, st.hm]) else { return Ok(sol) };
+    let Some(e) = penalty_of(setup, &sol, [st.hc, st.hm], None, staged.scene_xi) else { return Ok(sol) };
     let what = format!(
         "the cavitation penalty's ramp stalled at xi = {:.3e} of the scene's {:e}, where its estimated error is hc {:.3} %, hm {:.3} %",
         staged.xi,
@@ -917,7 +890,7 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
     let mut report = json!({
         "target": target,
         "reached": shortfall.is_none(),
-        "estimator": "change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change; hc and hm add the cavitation penalty's own error, from the films at the staged penalty xi = 1e3 and at the level's xi, converging like xi^(-1/4), or where that decides whether the level is the last, with a third film at their geometric mean, at the order the three show (0.1 to 1)",
+        "estimator": format!("change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change; each adds the cavitation penalty's own error c xi^(-p) of values converging like q_inf + c xi^(-p): |d ln q / d ln xi| / p with the slope from the value's adjoint, p from the slope and the change from the staged penalty xi = 1e3 (0.1 to 1; {} where the penalty was not staged; fx and fz at the slower of hc's and hm's orders)", super::estimate::ASSUMED_PENALTY_ORDER),
         "levels": levels.iter().enumerate().map(|(k, l)| {
             let mut v = json!({
                 "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,

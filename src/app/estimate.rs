@@ -7,9 +7,10 @@
 //! convergence ([`estimate_scaled`]). A level cut
 //! to the unknowns budget carries the estimate before it over ([`estimate_after_cut`]).
 //!
-//! To the change-based estimate of hc and hm is added the cavitation penalty's own error,
-//! where the penalty was staged ([`penalty_error`]): the discretisation's estimate does not
-//! see it, since every level has it.
+//! To each change-based estimate is added the cavitation penalty's own error
+//! ([`penalty_error`], from the films at the staged penalty 1e3 and at the level's xi and
+//! the values' slopes in xi from their adjoints): the discretisation's estimate does not
+//! see it, since every level has the same penalty.
 use super::adapt::Level;
 use serde_json::json;
 
@@ -30,18 +31,19 @@ const FASTEST_CONTRACTION: f64 = 0.125;
 pub const FULL_LEVEL_SHARE: f64 = 0.9;
 
 /// The slowest order in the cavitation penalty xi the penalty's estimate assumes: the films'
-/// error falls like xi^(-p), and p is measured from three penalties ([`penalty_error`]);
-/// when the changes do not shrink, p is this. The slowest measured was 0.16 per decade (hm
-/// at M = 500, L = 8 on a 0.125 a mesh, xi = 1e3, 1e4, 1e5); M = 10, L = 6 showed 0.44
+/// error falls like xi^(-p), and p is measured ([`penalty_error`]); where the measurement
+/// does not fit that form, p is this. The slowest measured was 0.16 per decade (hm at
+/// M = 500, L = 8 on a 0.125 a mesh, xi = 1e3, 1e4, 1e5); M = 10, L = 6 showed 0.44
 /// (docs/accuracy.md, "The cavitation penalty's own error").
 pub const SLOWEST_PENALTY_ORDER: f64 = 0.1;
 
-/// The order assumed from two penalties: the cavitation boundary, where the pressure and its
-/// slope vanish, moves by the square root of the cavitated pressure's shift, which goes like
-/// xi^(-1/2) inside the penalty's smoothed kink. Where the estimate from two films decides
-/// whether a level is the last (or raises the penalty), the adaptive loop solves a third
-/// film and measures the order instead.
-pub const TWO_FILM_PENALTY_ORDER: f64 = 0.25;
+/// The order assumed where only one of a change and a slope is known: the slope alone (a
+/// penalty that was not staged: the scene's xi is at most the staging penalty 1e3), or two
+/// penalties without a slope (the adjoint failed). Below the slowest order measured from
+/// two films and the slope on the last levels of five points at xi = 1e4 (hm 0.30-0.45, hc
+/// 0.18-0.43; table2-ue2's hc the slowest), so that the part is not under-estimated where
+/// the order is not known (docs/accuracy.md, "The cavitation penalty's own error").
+pub const ASSUMED_PENALTY_ORDER: f64 = 0.15;
 
 /// The fastest order the estimate assumes: a cavitated nodal pressure's own, -O(1/xi)
 /// (`reynolds::cavitation`); a faster observed contraction is a crossing by chance.
@@ -72,40 +74,84 @@ pub const MAX_RAISED_PENALTY: f64 = 1e7;
 /// stall sooner.
 pub fn raised_penalty(p: &PenaltyError, est: Option<&Estimate>, target: f64) -> Option<f64> {
     let raised = 10.0 * p.scene_xi;
-    let mesh_within = est.is_some_and(|e| e.films_mesh_part() < target);
-    (mesh_within && !p.short() && p.hc.max(p.hm) > PENALTY_RAISE_SHARE * target && raised <= MAX_RAISED_PENALTY).then_some(raised)
+    let mesh_within = est.is_some_and(|e| e.mesh_part() < target);
+    let part = p.parts().into_iter().fold(0.0, f64::max);
+    (mesh_within && !p.short() && part > PENALTY_RAISE_SHARE * target && raised <= MAX_RAISED_PENALTY).then_some(raised)
 }
 
-/// The estimated relative error left at the last penalty of a film with values `qs` at the
-/// ascending penalties `xis` (two or three, the same mesh), for q(xi) = q_inf + c xi^(-p):
-/// with c (x1^-p - x2^-p) the last change, the error at x2 is that change times
-/// x2^-p / (x1^-p - x2^-p). p is the order the last three values show
-/// ([`observed_penalty_order`]), or [`TWO_FILM_PENALTY_ORDER`] with two. With three, the
-/// estimate is at least what the first change leaves at the fastest order: a last change
-/// that is small by chance does not make it vanish.
-pub fn penalty_error(qs: &[f64], xis: &[f64]) -> f64 {
+/// The estimated relative error left at the last penalty of a value with values `qs` at the
+/// ascending penalties `xis` of one level (one to three, the same mesh) and, where the
+/// adjoint gave it, its slope `slope` = d ln q / d ln xi at the last penalty, for
+/// q(xi) = q_inf + c xi^(-p); with the order p it used.
+/// - Three values: p from them ([`observed_penalty_order`]); the error at x2 is the last
+///   change times x2^-p / (x1^-p - x2^-p), and at least what the first change leaves at the
+///   fastest order.
+/// - Two values and the slope: the slope is -p c x2^-p and the change c (x2^-p - x1^-p),
+///   so their ratio ((x2/x1)^p - 1)/p gives p ([`slope_penalty_order`]); the error
+///   c x2^-p is |slope|/p, and at least what the change leaves at the fastest order (a
+///   slope small by chance does not make it vanish).
+/// - One value and the slope (a penalty that was not staged), or two values without a
+///   slope: at [`ASSUMED_PENALTY_ORDER`].
+pub fn penalty_error(qs: &[f64], xis: &[f64], slope: Option<f64>) -> (f64, f64) {
     let n = qs.len().min(xis.len());
-    if n < 2 || xis[n - 1] <= xis[n - 2] || qs[n - 1] == 0.0 {
-        return 0.0;
+    let none = (0.0, FASTEST_PENALTY_ORDER);
+    if n == 0 || qs[n - 1] == 0.0 || (n >= 2 && xis[n - 1] <= xis[n - 2]) {
+        return none;
     }
+    let q = qs[n - 1].abs();
     let left = |d: f64, x1: f64, x2: f64, p: f64| d.abs() * x2.powf(-p) / (x1.powf(-p) - x2.powf(-p));
-    let (x1, x2) = (xis[n - 2], xis[n - 1]);
-    let d = qs[n - 1] - qs[n - 2];
-    let mut e = if n >= 3 {
-        let p = observed_penalty_order(&qs[n - 3..n], &xis[n - 3..n]);
-        let x0 = xis[n - 3];
-        // The first change's error left at x1 at order 1, carried to x2 (times x1/x2).
-        let guard = left(qs[n - 2] - qs[n - 3], x0, x1, FASTEST_PENALTY_ORDER) * x1 / x2;
-        left(d, x1, x2, p).max(guard)
-    } else {
-        left(d, x1, x2, TWO_FILM_PENALTY_ORDER)
+    let (e, p) = match (n, slope) {
+        (1, None) => return none,
+        (1, Some(s)) => (s.abs() / ASSUMED_PENALTY_ORDER, ASSUMED_PENALTY_ORDER),
+        (2, Some(s)) => {
+            let (x1, x2) = (xis[0], xis[1]);
+            let d = (qs[1] - qs[0]) / q;
+            let p = slope_penalty_order(d, s, x2 / x1);
+            ((s.abs() / p).max(left(d, x1, x2, FASTEST_PENALTY_ORDER)), p)
+        }
+        (2, None) => (left(qs[1] - qs[0], xis[0], xis[1], ASSUMED_PENALTY_ORDER) / q, ASSUMED_PENALTY_ORDER),
+        _ => {
+            let p = observed_penalty_order(&qs[n - 3..n], &xis[n - 3..n]);
+            let (x0, x1, x2) = (xis[n - 3], xis[n - 2], xis[n - 1]);
+            // The first change's error left at x1 at order 1, carried to x2 (times x1/x2).
+            let guard = left(qs[n - 2] - qs[n - 3], x0, x1, FASTEST_PENALTY_ORDER) * x1 / x2;
+            (left(qs[n - 1] - qs[n - 2], x1, x2, p).max(guard) / q, p)
+        }
     };
-    e /= qs[n - 1].abs();
     if e.is_finite() {
-        e
+        (e, p)
     } else {
-        0.0
+        none
     }
+}
+
+/// The order p in xi that a relative change `change` from x1 to x2 = `ratio` x1 and the
+/// slope `slope` = d ln q / d ln xi at x2 show, within [[`SLOWEST_PENALTY_ORDER`],
+/// [`FASTEST_PENALTY_ORDER`]]: the p at which (ratio^p - 1)/p, which grows with p, is
+/// change/slope (bisection). A change and a slope of opposite signs are no sequence of that
+/// kind: the slowest order.
+pub fn slope_penalty_order(change: f64, slope: f64, ratio: f64) -> f64 {
+    if slope == 0.0 || change * slope <= 0.0 {
+        return SLOWEST_PENALTY_ORDER;
+    }
+    let want = change / slope;
+    let g = |p: f64| (ratio.powf(p) - 1.0) / p;
+    let (mut lo, mut hi) = (SLOWEST_PENALTY_ORDER, FASTEST_PENALTY_ORDER);
+    if want <= g(lo) {
+        return lo;
+    }
+    if want >= g(hi) {
+        return hi;
+    }
+    for _ in 0..60 {
+        let m = 0.5 * (lo + hi);
+        if g(m) < want {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 /// The order p in xi that three values `qs` at penalties `xis` show, within
@@ -140,21 +186,51 @@ pub fn observed_penalty_order(qs: &[f64], xis: &[f64]) -> f64 {
 
 /// The cavitation penalty of a level: the xi it was solved at (below the scene's when its
 /// ramp stalled, [`SHORT_PENALTY_SHARE`]), the scene's, and the estimated relative errors
-/// of hc and hm it leaves ([`penalty_error`] from the state at the staged `base_xi`).
+/// it leaves in hc and hm ([`penalty_error`]) and, with friction, in fx and fz (relative
+/// to the friction coefficient's magnitude, from their slopes at the slower of hc's and
+/// hm's orders: the friction's dependence on xi is through the film and the pressure).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PenaltyError {
     pub xi: f64,
     pub scene_xi: f64,
     pub hc: f64,
     pub hm: f64,
+    pub friction: Option<[f64; 2]>,
+    /// The orders in xi the estimates of hc and hm used.
+    pub order: [f64; 2],
+    /// d ln q / d ln xi of hc and hm at `xi`, from the adjoints, where they were solved.
+    pub slope: Option<[f64; 2]>,
+}
+
+/// The slopes d ln q / d ln xi of a level's values at its penalty, from their adjoints:
+/// hc, hm and, with friction, fx and fz (relative to the friction coefficient's magnitude).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PenaltySlopes {
+    pub films: [f64; 2],
+    pub friction: Option<[f64; 2]>,
 }
 
 impl PenaltyError {
     /// From the films hc, hm (any common unit) at the ascending penalties `xis` of one level,
-    /// the last the one it was solved at, and the scene's `scene_xi`.
-    pub fn of(xis: &[f64], films: &[[f64; 2]], scene_xi: f64) -> PenaltyError {
-        let e = |i: usize| penalty_error(&films.iter().map(|f| f[i]).collect::<Vec<_>>(), xis);
-        PenaltyError { xi: xis.last().copied().unwrap_or(scene_xi), scene_xi, hc: e(0), hm: e(1) }
+    /// the last the one it was solved at, their slopes there where the adjoints gave them,
+    /// and the scene's `scene_xi`. None when nothing can be estimated (one penalty and no
+    /// slope).
+    pub fn of(xis: &[f64], films: &[[f64; 2]], slopes: Option<PenaltySlopes>, scene_xi: f64) -> Option<PenaltyError> {
+        if xis.len() < 2 && slopes.is_none() {
+            return None;
+        }
+        let e = |i: usize| penalty_error(&films.iter().map(|f| f[i]).collect::<Vec<_>>(), xis, slopes.map(|s| s.films[i]));
+        let ((hc, pc), (hm, pm)) = (e(0), e(1));
+        let slowest = pc.min(pm);
+        Some(PenaltyError {
+            xi: xis.last().copied().unwrap_or(scene_xi),
+            scene_xi,
+            hc,
+            hm,
+            friction: slopes.and_then(|s| s.friction).map(|f| f.map(|v| v.abs() / slowest)),
+            order: [pc, pm],
+            slope: slopes.map(|s| s.films),
+        })
     }
 
     /// The level was solved at a penalty below the scene's (its ramp stalled).
@@ -162,15 +238,32 @@ impl PenaltyError {
         self.xi < self.scene_xi
     }
 
+    /// The parts of the estimated values: hc, hm and, with friction, fx and fz.
+    pub fn parts(&self) -> Vec<f64> {
+        let mut v = vec![self.hc, self.hm];
+        v.extend(self.friction.iter().flatten());
+        v
+    }
+
     pub(super) fn json(&self) -> serde_json::Value {
-        json!({ "xi": self.xi, "scene_xi": self.scene_xi, "estimated_error": { "hc": self.hc, "hm": self.hm } })
+        let mut e = json!({ "hc": self.hc, "hm": self.hm });
+        if let Some([fx, fz]) = self.friction {
+            e["fx"] = json!(fx);
+            e["fz"] = json!(fz);
+        }
+        let mut v = json!({ "xi": self.xi, "scene_xi": self.scene_xi, "estimated_error": e, "order": { "hc": self.order[0], "hm": self.order[1] } });
+        if let Some([sc, sm]) = self.slope {
+            v["slope"] = json!({ "hc": sc, "hm": sm });
+        }
+        v
     }
 }
 
 /// The estimated relative errors of a level's target quantities: hc and hm, and with
 /// friction fx and fz, each relative to the magnitude of the friction coefficient
 /// sqrt(fx^2 + fz^2) (fz vanishes by symmetry without spin, so its own size is no scale).
-/// hc and hm include the cavitation penalty's part, `penalty`, where it is estimated.
+/// Each includes the cavitation penalty's part, `penalty` and `friction_penalty`, where it
+/// is estimated.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
     pub hc: f64,
@@ -178,6 +271,8 @@ pub struct Estimate {
     pub friction: Option<[f64; 2]>,
     /// The cavitation penalty's part of hc and hm.
     pub penalty: Option<[f64; 2]>,
+    /// The cavitation penalty's part of fx and fz.
+    pub friction_penalty: Option<[f64; 2]>,
 }
 
 impl Estimate {
@@ -192,9 +287,13 @@ impl Estimate {
             .iter()
             .map(|(q, scale)| if cut { estimate_after_cut(q, &halvings, *scale) } else { estimate_scaled(q, &halvings, *scale) })
             .collect::<Option<Vec<f64>>>()?;
-        let penalty = levels.last().and_then(|l| l.penalty).map(|p| [p.hc, p.hm]);
+        let p = levels.last().and_then(|l| l.penalty);
+        let penalty = p.map(|p| [p.hc, p.hm]);
         let [pc, pm] = penalty.unwrap_or_default();
-        Some(Estimate { hc: e[0] + pc, hm: e[1] + pm, friction: (e.len() == 4).then(|| [e[2], e[3]]), penalty })
+        let friction_penalty = p.and_then(|p| p.friction).filter(|_| e.len() == 4);
+        let [px, pz] = friction_penalty.unwrap_or_default();
+        let friction = (e.len() == 4).then(|| [e[2] + px, e[3] + pz]);
+        Some(Estimate { hc: e[0] + pc, hm: e[1] + pm, friction, penalty, friction_penalty })
     }
 
     /// Whether a level cut to the budget after the last of `levels` could bring every
@@ -202,17 +301,26 @@ impl Estimate {
     /// cases/hard/spin-0.33deg it cost 800 s and moved fx's estimate from 1.31 % to 1.29 %).
     pub(super) fn cut_could_reach(levels: &[Level], target: f64) -> bool {
         let halvings = halvings(levels);
-        let penalty = levels.last().and_then(|l| l.penalty).map_or([0.0; 2], |p| [p.hc, p.hm]);
+        let penalty = levels.last().and_then(|l| l.penalty).map_or(vec![], |p| p.parts());
         sequences(levels)
             .iter()
             .enumerate()
             .all(|(i, (q, scale))| least_after_cut(q, &halvings, *scale).is_some_and(|e| e + penalty.get(i).unwrap_or(&0.0) < target))
     }
 
-    /// The larger of hc's and hm's estimates less the cavitation penalty's part: the mesh's.
-    pub(super) fn films_mesh_part(&self) -> f64 {
-        let [pc, pm] = self.penalty.unwrap_or_default();
-        (self.hc - pc).max(self.hm - pm)
+    /// The largest estimate less the cavitation penalty's part: the mesh's.
+    pub(super) fn mesh_part(&self) -> f64 {
+        self.values().iter().zip(self.penalty_parts().iter().chain(std::iter::repeat(&0.0))).map(|(v, p)| v - p).fold(0.0, f64::max)
+    }
+
+    /// The cavitation penalty's part of each estimated value ([`Estimate::values`]), zero
+    /// where none is estimated.
+    fn penalty_parts(&self) -> Vec<f64> {
+        let mut v = self.penalty.unwrap_or_default().to_vec();
+        if self.friction.is_some() {
+            v.extend(self.friction_penalty.unwrap_or_default());
+        }
+        v
     }
 
     /// Every estimated error.
@@ -229,7 +337,11 @@ impl Estimate {
             s.push_str(&format!(", fx {:.2} %, fz {:.2} %", 100.0 * fx, 100.0 * fz));
         }
         if let Some([pc, pm]) = self.penalty {
-            s.push_str(&format!(" (the cavitation penalty's part: hc {:.3} %, hm {:.3} %)", 100.0 * pc, 100.0 * pm));
+            s.push_str(&format!(" (the cavitation penalty's part: hc {:.3} %, hm {:.3} %", 100.0 * pc, 100.0 * pm));
+            if let Some([px, pz]) = self.friction_penalty.filter(|_| self.friction.is_some()) {
+                s.push_str(&format!(", fx {:.3} %, fz {:.3} %", 100.0 * px, 100.0 * pz));
+            }
+            s.push(')');
         }
         s
     }
@@ -383,6 +495,11 @@ mod tests {
         }
     }
 
+    /// A level's penalty record with only the hm part set (hc 1e-5).
+    fn penalty_at(xi: f64, scene_xi: f64, hm: f64) -> PenaltyError {
+        PenaltyError { xi, scene_xi, hc: 1e-5, hm, friction: None, order: [0.25; 2], slope: None }
+    }
+
     #[test]
     fn the_penalty_error_finds_the_order_of_films_that_converge_in_xi() {
         // q(xi) = 0.3 + 0.02 xi^(-p) at 1e3, 10^3.5, 1e4: the order is found and the error
@@ -393,33 +510,93 @@ mod tests {
             let qs: Vec<f64> = xis.iter().map(|&x| q(x)).collect();
             assert!((observed_penalty_order(&qs, &xis) - p).abs() < 1e-9, "order {p}");
             let exact = 0.02 * f64::powf(1e4, -p) / q(1e4);
-            let e = penalty_error(&qs, &xis);
+            let (e, order) = penalty_error(&qs, &xis, None);
             assert!((e / exact - 1.0).abs() < 1e-6, "order {p}: {e} against {exact}");
+            assert!((order - p).abs() < 1e-9);
         }
         // Unequal steps (a ramp kept short of the scene's xi, at 2.4e3).
         let q = |xi: f64| 0.3 - 0.01 * xi.powf(-0.3);
         let xis = [1e3, 1.7e3, 2.4e3];
         let qs: Vec<f64> = xis.iter().map(|&x| q(x)).collect();
         let exact = 0.01 * f64::powf(2.4e3, -0.3) / q(2.4e3);
-        assert!((penalty_error(&qs, &xis) / exact - 1.0).abs() < 1e-6);
-        // Two penalties: the order of two films, exact for films of that order.
-        let q = |xi: f64| 0.3 + 0.02 * xi.powf(-TWO_FILM_PENALTY_ORDER);
-        let e = penalty_error(&[q(1e3), q(1e4)], &[1e3, 1e4]);
-        assert!((e / (0.02 * f64::powf(1e4, -TWO_FILM_PENALTY_ORDER) / q(1e4)) - 1.0).abs() < 1e-9);
+        assert!((penalty_error(&qs, &xis, None).0 / exact - 1.0).abs() < 1e-6);
+        // Two penalties without a slope: the order of two films, exact for films of that order.
+        let q = |xi: f64| 0.3 + 0.02 * xi.powf(-ASSUMED_PENALTY_ORDER);
+        let (e, _) = penalty_error(&[q(1e3), q(1e4)], &[1e3, 1e4], None);
+        assert!((e / (0.02 * f64::powf(1e4, -ASSUMED_PENALTY_ORDER) / q(1e4)) - 1.0).abs() < 1e-9);
         // Changes that do not shrink or change sign: the slowest order.
         assert_eq!(observed_penalty_order(&[1.0, 1.1, 1.3], &[1e3, 3e3, 1e4]), SLOWEST_PENALTY_ORDER);
         assert_eq!(observed_penalty_order(&[1.0, 1.1, 1.05], &[1e3, 3e3, 1e4]), SLOWEST_PENALTY_ORDER);
         // A last change of zero by chance: the first change at the fastest order remains.
-        assert!(penalty_error(&[1.0, 1.001, 1.001], &[1e3, 3e3, 1e4]) > 1e-4);
-        // One penalty: nothing to estimate.
-        assert_eq!(penalty_error(&[0.3], &[1e4]), 0.0);
+        assert!(penalty_error(&[1.0, 1.001, 1.001], &[1e3, 3e3, 1e4], None).0 > 1e-4);
+        // One penalty and no slope: nothing to estimate.
+        assert_eq!(penalty_error(&[0.3], &[1e4], None).0, 0.0);
+    }
+
+    #[test]
+    fn the_penalty_error_from_two_films_and_the_slope_finds_their_order() {
+        // q(xi) = q_inf + c xi^(-p): the slope d ln q / d ln xi = -p c xi^(-p) / q. From the
+        // films at 1e3 and 1e4 and the slope at 1e4 the order and the error are exact, for
+        // either sign of c and the orders measured (0.16, 0.44) and 1/xi.
+        for (p, c) in [(0.16, 0.02), (0.44, -0.01), (1.0, 0.05)] {
+            let q = |xi: f64| 0.3 + c * xi.powf(-p);
+            let slope = -p * c * f64::powf(1e4, -p) / q(1e4);
+            let (e, order) = penalty_error(&[q(1e3), q(1e4)], &[1e3, 1e4], Some(slope));
+            let exact = (c * f64::powf(1e4, -p) / q(1e4)).abs();
+            assert!((order - p).abs() < 1e-9, "order {order} against {p}");
+            assert!((e / exact - 1.0).abs() < 1e-9, "order {p}: {e} against {exact}");
+        }
+        // M = 10, L = 6 on a fixed 0.125 a mesh: hm 0.311899, 0.312167 um at xi = 1e3, 1e4 and
+        // the adjoint's slope 2.0698e-4 at 1e4 give the order 0.47 (0.39-0.52 between
+        // neighbouring slopes at 1e3 to 2e4) and an error near the 0.05 % the films at
+        // 1e3-1e5 show.
+        let (e, order) = penalty_error(&[0.311899, 0.312167], &[1e3, 1e4], Some(2.0698e-4));
+        assert!((0.44..0.50).contains(&order), "{order}");
+        assert!((4e-4..5e-4).contains(&e), "{e}");
+        // A slope of the other sign than the change: the slowest order.
+        assert_eq!(slope_penalty_order(1e-3, -1e-4, 10.0), SLOWEST_PENALTY_ORDER);
+        // A slope near zero by chance: the change at the fastest order remains.
+        let (e, order) = penalty_error(&[1.0, 1.009], &[1e3, 1e4], Some(1e-9));
+        assert_eq!(order, FASTEST_PENALTY_ORDER);
+        assert!((e - 0.009 / 9.0 / 1.009).abs() < 1e-12, "{e}");
+        // The slope alone (a penalty that was not staged): at the order assumed for it.
+        let (e, order) = penalty_error(&[0.3], &[1e3], Some(-2e-4));
+        assert_eq!(order, ASSUMED_PENALTY_ORDER);
+        assert!((e - 2e-4 / ASSUMED_PENALTY_ORDER).abs() < 1e-15);
+        // Three films keep their own order; the slope is reported, not used.
+        let q = |xi: f64| 0.3 + 0.02 * xi.powf(-0.3);
+        let xis = [1e3, 1.7e3, 2.4e3];
+        let qs: Vec<f64> = xis.iter().map(|&x| q(x)).collect();
+        assert_eq!(penalty_error(&qs, &xis, Some(1.0)), penalty_error(&qs, &xis, None));
+    }
+
+    #[test]
+    fn a_level_penalty_record_carries_the_friction_part_at_the_slower_film_order() {
+        let slopes = PenaltySlopes { films: [-1e-5, 2e-4], friction: Some([3e-4, -1e-4]) };
+        // Unstaged: one penalty and the slopes.
+        let p = PenaltyError::of(&[1e3], &[[0.46, 0.31]], Some(slopes), 1e3).unwrap();
+        assert_eq!((p.xi, p.scene_xi, p.order), (1e3, 1e3, [ASSUMED_PENALTY_ORDER; 2]));
+        let [fx, fz] = p.friction.unwrap();
+        assert!((fx - 3e-4 / ASSUMED_PENALTY_ORDER).abs() < 1e-15 && (fz - 1e-4 / ASSUMED_PENALTY_ORDER).abs() < 1e-15);
+        assert_eq!(p.parts().len(), 4);
+        // Nothing without a second film or a slope.
+        assert_eq!(PenaltyError::of(&[1e3], &[[0.46, 0.31]], None, 1e3), None);
+        let json = p.json();
+        assert_eq!(json["estimated_error"]["fx"], fx);
+        assert_eq!(json["slope"]["hm"], 2e-4);
     }
 
     #[test]
     fn the_penalty_is_raised_while_its_part_is_above_a_quarter_of_the_target() {
-        let at = |xi: f64, hm: f64| PenaltyError { xi, scene_xi: 1e4, hc: 1e-5, hm };
+        let at = |xi: f64, hm: f64| penalty_at(xi, 1e4, hm);
         // The mesh's part of hm 0.06 %, below the target 0.001.
-        let est = |p: &PenaltyError| Estimate { hc: 2e-4 + p.hc, hm: 6e-4 + p.hm, friction: None, penalty: Some([p.hc, p.hm]) };
+        let est = |p: &PenaltyError| Estimate {
+            hc: 2e-4 + p.hc,
+            hm: 6e-4 + p.hm,
+            friction: None,
+            penalty: Some([p.hc, p.hm]),
+            friction_penalty: None,
+        };
         let p = at(1e4, 7.5e-4);
         assert_eq!(raised_penalty(&p, Some(&est(&p)), 0.001), Some(1e5));
         // Not while the mesh's part is above the target, nor on a first level (no estimate).
@@ -432,21 +609,34 @@ mod tests {
         let short = at(2.4e3, 2.4e-3);
         assert_eq!(raised_penalty(&short, Some(&est(&short)), 0.01), None);
         // Not beyond the largest raised penalty.
-        let top = PenaltyError { xi: MAX_RAISED_PENALTY, scene_xi: MAX_RAISED_PENALTY, hc: 0.0, hm: 1e-3 };
+        let top = penalty_at(MAX_RAISED_PENALTY, MAX_RAISED_PENALTY, 1e-3);
         assert_eq!(raised_penalty(&top, Some(&est(&top)), 0.001), None);
+        // A scene whose penalty was not staged (1e3) is raised to 1e4 like any other.
+        let unstaged = penalty_at(1e3, 1e3, 7.5e-4);
+        assert_eq!(raised_penalty(&unstaged, Some(&est(&unstaged)), 0.001), Some(1e4));
+        // The friction's penalty part raises it too; the friction's mesh part holds it back.
+        let with_friction = |fx_mesh: f64| {
+            let p = PenaltyError { friction: Some([8e-4, 0.0]), ..penalty_at(1e4, 1e4, 1e-4) };
+            let e = Estimate { friction: Some([fx_mesh + 8e-4, 0.0]), friction_penalty: p.friction, ..est(&p) };
+            raised_penalty(&p, Some(&e), 0.001)
+        };
+        assert_eq!(with_friction(1e-4), Some(1e5));
+        assert_eq!(with_friction(2e-3), None);
     }
 
     #[test]
-    fn the_penalty_part_adds_to_the_films_estimates_only() {
+    fn the_penalty_part_adds_to_each_estimate() {
         let mut levels: Vec<Level> =
             [(1.05, 0.52), (1.02, 0.51), (1.01, 0.505)].iter().map(|&(c, m)| level(c, m, Some([0.05, 0.0]))).collect();
         let without = Estimate::of(&levels).unwrap();
-        levels[2].penalty = Some(PenaltyError { xi: 1e4, scene_xi: 1e4, hc: 1e-4, hm: 5e-4 });
+        levels[2].penalty = Some(PenaltyError { hc: 1e-4, friction: Some([2e-4, 0.0]), ..penalty_at(1e4, 1e4, 5e-4) });
         let with = Estimate::of(&levels).unwrap();
         assert!((with.hc - without.hc - 1e-4).abs() < 1e-15 && (with.hm - without.hm - 5e-4).abs() < 1e-15);
-        assert_eq!(with.friction, without.friction);
+        let ([fx, fz], [fx0, fz0]) = (with.friction.unwrap(), without.friction.unwrap());
+        assert!((fx - fx0 - 2e-4).abs() < 1e-15 && fz == fz0);
         assert_eq!(with.penalty, Some([1e-4, 5e-4]));
-        assert!(with.describe().contains("penalty's part: hc 0.010 %, hm 0.050 %"), "{}", with.describe());
+        assert!((with.mesh_part() - without.values().into_iter().fold(0.0, f64::max)).abs() < 1e-15);
+        assert!(with.describe().contains("penalty's part: hc 0.010 %, hm 0.050 %, fx 0.020 %, fz 0.000 %"), "{}", with.describe());
     }
 
     #[test]

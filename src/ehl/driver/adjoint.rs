@@ -34,15 +34,16 @@ use crate::solid::condense::Compliance;
 /// Options prefix of the adjoint's linear solver (`-adjoint_ksp_type`, ...).
 pub const ADJOINT_PREFIX: &str = "adjoint_";
 
-/// Relative step of the central difference of the residual in lambda_bar. The residual is
-/// smooth in lambda_bar (a power of it in the Poiseuille and stabilisation terms), so the
-/// difference is exact to O(1e-8) and the roundoff of F(x) ~ 0 stays near 1e-12 of dF/ds.
-const SPEED_STEP: f64 = 1e-4;
+/// Relative step of the central difference of the residual in a parameter. The residual is
+/// smooth in lambda_bar (a power of it in the Poiseuille and stabilisation terms) and in the
+/// penalty xi (linear in the penalty rows, smooth in their stabilisation), so the difference
+/// is exact to O(1e-8) and the roundoff of F(x) ~ 0 stays near 1e-12 of dF/ds.
+const PARAMETER_STEP: f64 = 1e-4;
 
 /// The adjoints of film values at a converged state, from one factorisation. Collective in every
 /// method. An adjoint z is in the layout of the system it was solved on (monolithic, or
 /// condensed: P and H0); [`Adjoint::pressure_part`] reads it per mesh node, and
-/// [`film_derivative`] pairs it with [`Adjoint::residual_speed_derivative`] of the same
+/// [`film_derivative`] pairs it with [`Adjoint::residual_derivative`] of the same
 /// system.
 pub struct Adjoint<'a> {
     form: Form<'a>,
@@ -235,15 +236,15 @@ impl Adjoint<'_> {
         index.iter().map(|&d| if d >= 0 { z[d as usize] } else { 0.0 }).collect()
     }
 
-    /// dF/d(ln lambda_bar) at the converged state, whole, on every rank, in the layout of
-    /// the adjoints.
-    pub fn residual_speed_derivative(&mut self) -> Result<Vec<f64>, Error> {
+    /// dF/d(ln s) at the converged state for the parameter `s`, whole, on every rank, in
+    /// the layout of the adjoints.
+    pub fn residual_derivative(&mut self, param: Parameter) -> Result<Vec<f64>, Error> {
         let local = self.local;
         match &mut self.form {
-            Form::Monolithic { system, x, .. } => speed_derivative(system, |s| &mut s.params, x, local),
-            Form::Condensed { system, x, .. } => speed_derivative(system, |s| &mut s.params, x, local),
+            Form::Monolithic { system, x, .. } => parameter_derivative(system, |s| &mut s.params, x, local, param),
+            Form::Condensed { system, x, .. } => parameter_derivative(system, |s| &mut s.params, x, local, param),
             Form::Newton { kept, x, .. } => {
-                let mut df = speed_derivative(&mut kept.system, |s| &mut s.params, x, local)?;
+                let mut df = parameter_derivative(&mut kept.system, |s| &mut s.params, x, local, param)?;
                 for (d, s) in kept.system.row_scales() {
                     df[d] /= s;
                 }
@@ -253,25 +254,44 @@ impl Adjoint<'_> {
     }
 }
 
-/// dF/d(ln lambda_bar) of `system` at `x` by a central difference (`params` reaches the
-/// system's parameters), whole, on every rank.
-fn speed_derivative<S: Problem>(system: &mut S, params: fn(&mut S) -> &mut EhlParams, x: &[f64], local: usize) -> Result<Vec<f64>, Error> {
+/// A parameter of the residual whose derivative [`Adjoint::residual_derivative`] gives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Parameter {
+    /// lambda_bar: the entrainment speed times the reference viscosity.
+    Speed,
+    /// The cavitation penalty xi (the penalty rows and their stabilisation).
+    Penalty,
+}
+
+/// dF/d(ln s) of `system` at `x` by a central difference (`params` reaches the system's
+/// parameters), whole, on every rank.
+fn parameter_derivative<S: Problem>(
+    system: &mut S,
+    params: fn(&mut S) -> &mut EhlParams,
+    x: &[f64],
+    local: usize,
+    param: Parameter,
+) -> Result<Vec<f64>, Error> {
     let (lambda, penalty) = (params(system).lambda_bar, params(system).penalty);
-    let mut at = |s: f64| -> Result<Vec<f64>, Error> {
-        params(system).set_operating(lambda * s.exp(), penalty);
+    let mut at = |step: f64| -> Result<Vec<f64>, Error> {
+        let f = step.exp();
+        match param {
+            Parameter::Speed => params(system).set_operating(lambda * f, penalty),
+            Parameter::Penalty => params(system).set_operating(lambda, penalty * f),
+        }
         let f = Vector::new(petsc::comm_world(), local)?;
         f.set_all(0.0)?;
         let eval = system.residual(x, &f)?;
         f.assemble()?;
         match eval {
             Eval::Ok => Ok(f.gather_all()?),
-            Eval::Domain(why) => Err(Error::numerical(format!("the speed derivative left the film's domain: {why}"))),
+            Eval::Domain(why) => Err(Error::numerical(format!("the residual's derivative in {param:?} left the film's domain: {why}"))),
         }
     };
-    let (plus, minus) = (at(SPEED_STEP), at(-SPEED_STEP));
+    let (plus, minus) = (at(PARAMETER_STEP), at(-PARAMETER_STEP));
     params(system).set_operating(lambda, penalty);
     let (plus, minus) = (plus?, minus?);
-    Ok(plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * SPEED_STEP)).collect())
+    Ok(plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * PARAMETER_STEP)).collect())
 }
 
 /// dJ/ds = -z . dF/ds for an adjoint `z` and a residual derivative `df` (both whole).

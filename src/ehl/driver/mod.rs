@@ -17,7 +17,7 @@ mod problem;
 mod start;
 
 use crate::error::Error;
-pub use adjoint::{film_derivative, Adjoint};
+pub use adjoint::{film_derivative, Adjoint, Parameter};
 pub use diagnostics::{check_jacobian, POLE_COLLAPSE};
 use policy::Attempt;
 pub use policy::{set_newton_defaults, set_newton_linear_solver, Coupling, CONDENSED_PREFIX};
@@ -189,22 +189,6 @@ impl<'a> EhlSolver<'a> {
     /// The coupling this solver uses.
     pub fn coupling(&self) -> Coupling {
         self.coupling
-    }
-
-    /// Plain Newton from `x`, a converged state of this mesh (monolithic layout), at the
-    /// scene's problem: no continuation and no Hertz start after a failure (the cavitation
-    /// penalty's third film, solved at another xi from a level's state). Releases a kept
-    /// Newton solver. Collective.
-    pub fn solve_near(&self, ctx: &'a Context, scene: &Scene, x: &[f64]) -> Result<EhlSolution, Error> {
-        self.release_newton();
-        let start = Start::Previous(x);
-        let attempt = Attempt::ladder(&start, self.comp.is_none())[0];
-        match &self.comp {
-            None => {
-                solve_monolithic(ctx, scene, self.mesh, self.part, self.dofs, self.layout, self.half, start, attempt, false).map(|(s, _)| s)
-            }
-            Some(comp) => solve_condensed(ctx, scene, self.mesh, self.layout, comp, self.half, start, attempt, false),
-        }
     }
 
     /// Solves the scene's operating point. `start`: a converged state of a neighbouring
