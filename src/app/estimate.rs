@@ -198,8 +198,8 @@ pub struct PenaltyError {
     pub friction: Option<[f64; 2]>,
     /// The orders in xi the estimates of hc and hm used.
     pub order: [f64; 2],
-    /// d ln q / d ln xi of hc and hm at `xi`, from the adjoints, where they were solved.
-    pub slope: Option<[f64; 2]>,
+    /// The values' slopes d ln q / d ln xi at `xi`, from the adjoints, where they were solved.
+    pub slope: Option<PenaltySlopes>,
 }
 
 /// The slopes d ln q / d ln xi of a level's values at its penalty, from their adjoints:
@@ -229,7 +229,7 @@ impl PenaltyError {
             hm,
             friction: slopes.and_then(|s| s.friction).map(|f| f.map(|v| v.abs() / slowest)),
             order: [pc, pm],
-            slope: slopes.map(|s| s.films),
+            slope: slopes,
         })
     }
 
@@ -252,8 +252,12 @@ impl PenaltyError {
             e["fz"] = json!(fz);
         }
         let mut v = json!({ "xi": self.xi, "scene_xi": self.scene_xi, "estimated_error": e, "order": { "hc": self.order[0], "hm": self.order[1] } });
-        if let Some([sc, sm]) = self.slope {
-            v["slope"] = json!({ "hc": sc, "hm": sm });
+        if let Some(s) = self.slope {
+            v["slope"] = json!({ "hc": s.films[0], "hm": s.films[1] });
+            if let Some([fx, fz]) = s.friction {
+                v["slope"]["fx"] = json!(fx);
+                v["slope"]["fz"] = json!(fz);
+            }
         }
         v
     }
@@ -584,6 +588,7 @@ mod tests {
         let json = p.json();
         assert_eq!(json["estimated_error"]["fx"], fx);
         assert_eq!(json["slope"]["hm"], 2e-4);
+        assert_eq!(json["slope"]["fx"], 3e-4);
     }
 
     #[test]
