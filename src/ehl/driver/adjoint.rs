@@ -1,6 +1,7 @@
 //! The adjoint of the converged system for a film value: which residuals move it, and by
 //! how much (goal-oriented refinement, `app::adapt`), and what a change of the speed
-//! parameter does to it (`output.speed_exponents`).
+//! parameter (`output.speed_exponents`) or of the cavitation penalty (the penalty's own
+//! error in the adaptive loop's estimate) does to it.
 //!
 //! For a converged state x of F(x) = 0 and a film value J(x) = sum_n w_n H_n (nodal films
 //! with weights summing to 1: the P2 interpolation at a point, or a mean over an area),
@@ -10,12 +11,13 @@
 //! says where a discretisation error costs J. dJ/dx from H_n = H0 + (X^2 + Z^2)/2 - U_y:
 //! 1 on H0 and -w_n on U_y of node n.
 //!
-//! A parameter s of the residual moves J by dJ/ds = -z . dF/ds. For s = ln lambda_bar
-//! (lambda_bar = 12 eta_R Ue R^2 / (a^3 p_H): the only place the entrainment speed and the
-//! reference viscosity enter the dimensionless system, the scales a and p_H do not depend
-//! on them) that is the film's exponent in eta_R Ue times J, the discrete counterpart of
-//! the 0.67 of Hamrock and Dowson's formula. dF/ds is a central difference of the residual
-//! in s on the same mesh and state.
+//! A parameter s of the residual ([`Parameter`]) moves J by dJ/ds = -z . dF/ds. For
+//! s = ln lambda_bar (lambda_bar = 12 eta_R Ue R^2 / (a^3 p_H): the only place the
+//! entrainment speed and the reference viscosity enter the dimensionless system, the scales
+//! a and p_H do not depend on them) that is the film's exponent in eta_R Ue times J, the
+//! discrete counterpart of the 0.67 of Hamrock and Dowson's formula; for s = ln xi it is
+//! the slope from which the penalty's error is estimated. dF/ds is a central difference of
+//! the residual in s on the same mesh and state.
 use super::problem::{ehl_params, lubricant};
 use super::EhlSolver;
 use super::Kept;
@@ -236,8 +238,8 @@ impl Adjoint<'_> {
         index.iter().map(|&d| if d >= 0 { z[d as usize] } else { 0.0 }).collect()
     }
 
-    /// dF/d(ln s) at the converged state for the parameter `s`, whole, on every rank, in
-    /// the layout of the adjoints.
+    /// dF/d(ln s) at the converged state for the parameter s = `param`, whole, on every
+    /// rank, in the layout of the adjoints.
     pub fn residual_derivative(&mut self, param: Parameter) -> Result<Vec<f64>, Error> {
         let local = self.local;
         match &mut self.form {
@@ -274,10 +276,10 @@ fn parameter_derivative<S: Problem>(
 ) -> Result<Vec<f64>, Error> {
     let (lambda, penalty) = (params(system).lambda_bar, params(system).penalty);
     let mut at = |step: f64| -> Result<Vec<f64>, Error> {
-        let f = step.exp();
+        let factor = step.exp();
         match param {
-            Parameter::Speed => params(system).set_operating(lambda * f, penalty),
-            Parameter::Penalty => params(system).set_operating(lambda, penalty * f),
+            Parameter::Speed => params(system).set_operating(lambda * factor, penalty),
+            Parameter::Penalty => params(system).set_operating(lambda, penalty * factor),
         }
         let f = Vector::new(petsc::comm_world(), local)?;
         f.set_all(0.0)?;
