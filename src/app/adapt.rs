@@ -559,7 +559,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             est: None,
             cut: cut.take(),
             halvings: if k == 0 { 1 } else { next.as_ref().map_or(1, |m| m.halvings) },
-            penalty: penalty_of(&setup, &sol, [st.hc, st.hm], None, scene.reynolds.penalty),
+            // Set below, once the slopes are known.
+            penalty: None,
         };
         over.clear();
         levels.push(level);
@@ -586,18 +587,17 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             Some(Err(e)) => Some(Err(Error::numerical(format!("the adjoint failed: {e}")))),
             _ => None,
         };
-        if penalised && goals_of.is_some() {
-            let slopes = match (&mut adjoint, &goals_of) {
-                (Some(Ok(a)), Some(Ok(g))) => collective::agree(&ctx.world, super::sensitivity::penalty_slopes(a, g)),
-                (_, Some(Err(e))) => Err(Error::numerical(e.to_string())),
-                _ => Err(Error::numerical("no adjoint")),
-            };
-            let slopes = slopes
-                .map_err(|e| ctx.log(format!("accuracy: the films' slopes in the cavitation penalty were not computed ({e}); its part of the estimate is from the staged films alone, where there are two")))
-                .ok();
-            levels.last_mut().expect("the level just pushed").penalty =
-                penalty_of(&setup, &sol, [st.hc, st.hm], slopes, scene.reynolds.penalty);
-        }
+        let slopes = match (&mut adjoint, &goals_of) {
+            (Some(Ok(a)), Some(Ok(g))) if penalised => collective::agree(&ctx.world, super::sensitivity::penalty_slopes(a, g)).map(Some),
+            (_, Some(Err(e))) if penalised => Err(Error::numerical(e.to_string())),
+            _ => Ok(None),
+        };
+        let slopes = slopes
+            .map_err(|e| ctx.log(format!("accuracy: the films' slopes in the cavitation penalty were not computed ({e}); its part of the estimate is from the staged films alone, where there are two")))
+            .ok()
+            .flatten();
+        levels.last_mut().expect("the level just pushed").penalty =
+            penalty_of(&setup, &sol, [st.hc, st.hm], slopes, scene.reynolds.penalty);
         let est = Estimate::of(&levels);
         let level = levels.last_mut().expect("the level just pushed");
         level.est = est;

@@ -134,24 +134,7 @@ pub fn slope_penalty_order(change: f64, slope: f64, ratio: f64) -> f64 {
     if slope == 0.0 || change * slope <= 0.0 {
         return SLOWEST_PENALTY_ORDER;
     }
-    let want = change / slope;
-    let g = |p: f64| (ratio.powf(p) - 1.0) / p;
-    let (mut lo, mut hi) = (SLOWEST_PENALTY_ORDER, FASTEST_PENALTY_ORDER);
-    if want <= g(lo) {
-        return lo;
-    }
-    if want >= g(hi) {
-        return hi;
-    }
-    for _ in 0..60 {
-        let m = 0.5 * (lo + hi);
-        if g(m) < want {
-            lo = m;
-        } else {
-            hi = m;
-        }
-    }
-    0.5 * (lo + hi)
+    order_where(|p| (ratio.powf(p) - 1.0) / p, change / slope)
 }
 
 /// The order p in xi that three values `qs` at penalties `xis` show, within
@@ -166,16 +149,23 @@ pub fn observed_penalty_order(qs: &[f64], xis: &[f64]) -> f64 {
     }
     let ratio = (d2 / d1).abs();
     let f = |p: f64| (xis[1].powf(-p) - xis[2].powf(-p)) / (xis[0].powf(-p) - xis[1].powf(-p));
+    // f falls as p grows: -f rises to -ratio.
+    order_where(|p| -f(p), -ratio)
+}
+
+/// The p in [[`SLOWEST_PENALTY_ORDER`], [`FASTEST_PENALTY_ORDER`]] at which `g`, rising in
+/// p, reaches `want` (bisection); the nearer end where it does not within them.
+fn order_where(g: impl Fn(f64) -> f64, want: f64) -> f64 {
     let (mut lo, mut hi) = (SLOWEST_PENALTY_ORDER, FASTEST_PENALTY_ORDER);
-    if ratio >= f(lo) {
+    if want <= g(lo) {
         return lo;
     }
-    if ratio <= f(hi) {
+    if want >= g(hi) {
         return hi;
     }
     for _ in 0..60 {
         let m = 0.5 * (lo + hi);
-        if f(m) > ratio {
+        if g(m) < want {
             lo = m;
         } else {
             hi = m;
@@ -314,7 +304,7 @@ impl Estimate {
 
     /// The largest estimate less the cavitation penalty's part: the mesh's.
     pub(super) fn mesh_part(&self) -> f64 {
-        self.values().iter().zip(self.penalty_parts().iter().chain(std::iter::repeat(&0.0))).map(|(v, p)| v - p).fold(0.0, f64::max)
+        self.values().iter().zip(self.penalty_parts()).map(|(v, p)| v - p).fold(0.0, f64::max)
     }
 
     /// The cavitation penalty's part of each estimated value ([`Estimate::values`]), zero
