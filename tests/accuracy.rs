@@ -112,6 +112,47 @@ fn a_moes_point_is_refined_to_its_target() {
     }
 }
 
+/// Cavitation as complementarity (`effects.cavitation = "complementarity"`) is the limit of
+/// the penalty model as xi grows where the mesh resolves the cavitation boundary's SUPG
+/// term alike: on one fixed mesh (M = 10, L = 6 at 0.25 a) the penalty's hc and hm rise
+/// and its pmax falls monotonically with xi = 1e4, 1e5, 1e6 (measured: hm 3.0938, 3.0946,
+/// 3.0949e-7 m, pmax 3.226, 3.214, 3.209e8 Pa) towards the complementarity values
+/// (3.0954e-7 m, 3.206e8 Pa), which lie beyond xi = 1e6 by less than the two decades before
+/// it moved them (hm: 1.7e-4 against 3.5e-4; pmax 8.9e-4 against 5.4e-3; Aitken's
+/// extrapolation of the three penalty values lands within 1.3e-4 of them). The reference is
+/// the other formulation; a complementarity residual that missed the Reynolds condition (a
+/// wrong partner, the penalty left in it, SUPG acting in the cavitated zone) moves the
+/// films by more than that.
+#[test]
+fn the_complementarity_film_is_the_limit_of_the_penalty_films() {
+    let dir = scratch("accuracy_complementarity");
+    let scene = repo().join("cases/references/moes-m10-l6.toml");
+    let solve = |name: &str, set: &[&str]| -> [f64; 3] {
+        let run = dir.join(name);
+        let mut args = vec![scene.to_str().unwrap(), "--output", run.to_str().unwrap()];
+        for k in ["mesh.contact_size=0.25", "output.png=false", "output.vtu=false"].iter().chain(set) {
+            args.extend(["--set", k]);
+        }
+        let out = mpirun(2, &args);
+        assert!(out.status.success(), "{name}: {}", text(&out));
+        let s = summary(&run);
+        [s["film"]["hc_m"].as_f64().unwrap(), s["film"]["hm_m"].as_f64().unwrap(), s["pressure"]["pmax_pa"].as_f64().unwrap()]
+    };
+    let c = solve("complementarity", &["effects.cavitation=complementarity"]);
+    let p: Vec<[f64; 3]> = ["1e4", "1e5", "1e6"]
+        .iter()
+        .map(|xi| solve(&format!("penalty-{xi}"), &["effects.cavitation=penalty", &format!("reynolds.penalty={xi}")]))
+        .collect();
+    for (q, name) in ["hc", "hm", "pmax"].iter().enumerate() {
+        let v: Vec<f64> = p.iter().map(|r| r[q]).chain([c[q]]).collect();
+        let rising = v[1] > v[0];
+        assert!(v.windows(2).all(|w| (w[1] > w[0]) == rising), "{name}: penalty 1e4..1e6 then complementarity: {v:?}");
+        assert!((c[q] - v[2]).abs() < (v[2] - v[0]).abs(), "{name}: {v:?}");
+    }
+    // Films rise towards the Reynolds condition; the pressure peak falls.
+    assert!(c[1] > p[0][1] && c[2] < p[0][2], "{c:?} {p:?}");
+}
+
 /// A target where refinement cannot apply is refused before anything runs, naming the key.
 #[test]
 fn a_target_is_refused_where_it_cannot_apply() {

@@ -303,6 +303,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
         };
         // The adjoint after the level solves on Newton's last factorisation.
+        // The complementarity form has no penalty error to estimate.
         let penalised = scene.effects.cavitation == crate::case::CavitationModel::Penalty;
         solver.keep_newton(acc.marking > 0.0 || scene.output.speed_exponents || penalised);
         // A staged penalty that stalls short of the scene's is judged by its error here.

@@ -122,6 +122,10 @@ pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
         KinematicsModel::Uniform => skipped.push("spin (effects.kinematics = \"uniform\": U_B = U_BO, U_D = U_DO, W = 0)".into()),
     }
     match e.cavitation {
+        CavitationModel::Complementarity => simulated.push(format!(
+            "cavitation: the Reynolds condition as complementarity (P >= 0, its residual >= 0, their product 0), from the penalty solution at xi = {}",
+            scene.reynolds.penalty.min(1e3)
+        )),
         CavitationModel::Penalty => simulated.push(format!("cavitation: penalty, xi = {}", scene.reynolds.penalty)),
         CavitationModel::Off => skipped.push("cavitation (effects.cavitation = \"none\": negative pressures kept)".into()),
     }

@@ -19,6 +19,7 @@ use crate::friction::pass::FrictionResult;
 use crate::mesh::size_field::SizeField;
 use crate::mesh::spec::dyadic_size;
 use crate::mesh::Mesh;
+use crate::reynolds::cavitation::Cavitation;
 use crate::reynolds::estimate::{dorfler_mark, element_residual};
 use crate::reynolds::jump::{edge_terms, jump_coefficient, triangle_shares, EdgeJump};
 use std::collections::BTreeMap;
@@ -42,7 +43,11 @@ pub(super) fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
     let lub = driver::lubricant(scene);
     let fluid = lub.fluid(driver::lambda_bar(scene));
     let vel = driver::velocity_field(scene);
-    let penalty = if scene.effects.cavitation == crate::case::CavitationModel::Penalty { scene.reynolds.penalty } else { 0.0 };
+    let cavitation = match scene.effects.cavitation {
+        crate::case::CavitationModel::Penalty => Cavitation::Penalty(scene.reynolds.penalty),
+        crate::case::CavitationModel::Complementarity => Cavitation::Complementarity,
+        crate::case::CavitationModel::Off => Cavitation::Off,
+    };
     let n = mesh.contact_tris.len();
     let mut eta = vec![0.0; n];
     // Edge (low, high vertex id) -> outward fluxes at its Gauss points, ordered from the
@@ -55,7 +60,7 @@ pub(super) fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
         let p = tri.map(|n| fields.p_node(n));
         let h = tri.map(|n| fields.h_node(n));
         let v = verts.map(|x| vel(x[0], x[1]));
-        let r = element_residual(&verts, &p, &h, &v, &fluid, penalty);
+        let r = element_residual(&verts, &p, &h, &v, &fluid, cavitation);
         eta[k] = r.interior;
         for e in 0..3 {
             let (a, b) = (tri[e], tri[(e + 1) % 3]);

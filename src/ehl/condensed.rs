@@ -10,7 +10,7 @@
 //! mesh.
 use super::step::{film_step_limit, FILM_COLLAPSE};
 use super::system::EhlProblem;
-use super::system::{clip_pressure_step, penalty_law, pressure_step_floor, EhlParams, Lubricant, CAVITATION_SMOOTHING};
+use super::system::{clip_pressure_step, complementarity, penalty_law, pressure_step_floor, EhlParams, Lubricant, CAVITATION_SMOOTHING};
 use crate::fem::p2tri::{p2_tri_weights, tri_area};
 use crate::mesh::Mesh;
 use crate::petsc::snes::{Eval, Problem};
@@ -297,6 +297,49 @@ impl<'a> CondensedSystem<'a> {
         (self.layout.ranges[self.rank], self.layout.ranges[self.rank + 1])
     }
 
+    /// The scaled Reynolds residual (with the penalty) of rows `lo..hi` (the load row, if
+    /// among them, left 0).
+    fn scaled_reynolds(&self, x: &[f64], h: &[f64], lo: usize, hi: usize) -> Vec<f64> {
+        let mut r = vec![0.0; hi - lo];
+        let row = |d: i32| (d >= 0 && (d as usize) >= lo && (d as usize) < hi).then(|| d as usize - lo);
+        let fluid = self.fluid();
+        for e in self.elements.iter().filter(|e| e.any_dof(|d| row(d).is_some())) {
+            let p = Self::element_p(x, e);
+            let he = e.face.map(|f| h[f]);
+            let pr = e.project(&self.eval(e, &p, &he, &fluid));
+            for a in 0..pr.n {
+                if let Some(l) = row(pr.dofs[a]) {
+                    r[l] += pr.r[a];
+                }
+            }
+        }
+        for jt in &self.jumps {
+            for (a, &d) in jt.rows.iter().enumerate() {
+                if let Some(l) = row(d) {
+                    r[l] += jt.residual_row(a, x);
+                }
+            }
+        }
+        for j in lo..hi.min(self.layout.n_p) {
+            r[j - lo] += self.params.penalty * self.p_area[j] * penalty_law(x[j]).0;
+        }
+        for (i, v) in r.iter_mut().enumerate() {
+            *v *= self.row_scale[lo + i];
+        }
+        r
+    }
+
+    /// Per pressure row, the derivatives (in P and in the scaled residual) of the
+    /// complementarity function at `x` (all rows; (0, 1) without complementarity).
+    fn complementarity_slopes(&self, x: &[f64], h: &[f64]) -> Vec<(f64, f64)> {
+        let np = self.layout.n_p;
+        if !self.params.stabilisation.complementarity {
+            return vec![(0.0, 1.0); np];
+        }
+        let r = self.scaled_reynolds(x, h, 0, np);
+        (0..np).map(|j| complementarity(x[j], r[j])).map(|(_, dp, df)| (dp, df)).collect()
+    }
+
     /// The pressure unknowns among this rank's rows.
     fn owned_p(&self) -> std::ops::Range<usize> {
         let (lo, hi) = self.owned();
@@ -392,6 +435,7 @@ impl<'a> CondensedSystem<'a> {
         let (_, hi) = self.owned();
         let h = self.film(x);
         let fluid = self.fluid();
+        let slopes = self.complementarity_slopes(x, &h);
         j.zero()?;
         for e in self.elements.iter().filter(|e| e.mine) {
             let p = Self::element_p(x, e);
@@ -400,7 +444,7 @@ impl<'a> CondensedSystem<'a> {
             for a in 0..pr.n {
                 let Some(_) = self.own_row(pr.dofs[a]) else { continue };
                 let r = pr.dofs[a] as usize;
-                let s = self.row_scale[r];
+                let s = self.row_scale[r] * slopes[r].1;
                 let mut cols = Vec::with_capacity(7);
                 let mut vals = Vec::with_capacity(7);
                 for b in 0..pr.n {
@@ -415,13 +459,15 @@ impl<'a> CondensedSystem<'a> {
         }
         for jt in &self.jumps {
             for (a, &r) in jt.rows.iter().enumerate().filter(|&(_, &r)| self.own_row(r).is_some()) {
-                let vals: Vec<f64> = (0..jt.rows.len()).map(|b| self.row_scale[r as usize] * jt.entry(a, b)).collect();
+                let s = self.row_scale[r as usize] * slopes[r as usize].1;
+                let vals: Vec<f64> = (0..jt.rows.len()).map(|b| s * jt.entry(a, b)).collect();
                 j.add_values(&[r], &jt.rows, &vals)?;
             }
         }
         for jn in self.owned_p() {
             let dv = penalty_slope(x[jn]);
-            j.add_values(&[jn as i32], &[jn as i32], &[self.row_scale[jn] * self.params.penalty * self.p_area[jn] * dv])?;
+            let (dp, df) = slopes[jn];
+            j.add_values(&[jn as i32], &[jn as i32], &[self.row_scale[jn] * df * self.params.penalty * self.p_area[jn] * dv + dp])?;
         }
         if hi > np {
             if self.fixed_h0.is_some() {
@@ -438,8 +484,9 @@ impl<'a> CondensedSystem<'a> {
 }
 
 impl EhlProblem for CondensedSystem<'_> {
-    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64) {
+    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64, complementarity: bool) {
         self.params.set_operating(lambda_bar, penalty);
+        self.params.stabilisation.complementarity = complementarity;
         self.lubricant = lubricant;
     }
 
@@ -484,7 +531,7 @@ impl EhlProblem for CondensedSystem<'_> {
             }
         }
         for (j, d) in diag.iter().enumerate().take(self.layout.n_p) {
-            let v = d.abs() + self.params.penalty * 1e-6;
+            let v = d.abs() + self.params.row_scale_floor();
             self.row_scale[j] = if v > 0.0 { 1.0 / v } else { 1.0 };
         }
         Ok(())
@@ -505,30 +552,11 @@ impl Problem for CondensedSystem<'_> {
             return Ok(Eval::Domain(why));
         }
         let (lo, hi) = self.owned();
-        let mut r = vec![0.0; hi - lo];
-        let fluid = self.fluid();
-        for e in self.elements.iter().filter(|e| e.mine) {
-            let p = Self::element_p(x, e);
-            let he = e.face.map(|f| h[f]);
-            let pr = e.project(&self.eval(e, &p, &he, &fluid));
-            for a in 0..pr.n {
-                if let Some(l) = self.own_row(pr.dofs[a]) {
-                    r[l] += pr.r[a];
-                }
+        let mut r = self.scaled_reynolds(x, &h, lo, hi);
+        if self.params.stabilisation.complementarity {
+            for j in self.owned_p() {
+                r[j - lo] = complementarity(x[j], r[j - lo]).0;
             }
-        }
-        for jt in &self.jumps {
-            for (a, &d) in jt.rows.iter().enumerate() {
-                if let Some(l) = self.own_row(d) {
-                    r[l] += jt.residual_row(a, x);
-                }
-            }
-        }
-        for j in self.owned_p() {
-            r[j - lo] += self.params.penalty * self.p_area[j] * penalty_law(x[j]).0;
-        }
-        for (i, v) in r.iter_mut().enumerate() {
-            *v *= self.row_scale[lo + i];
         }
         if hi > self.layout.n_p {
             // Load balance, on the rank that owns H0.
@@ -668,6 +696,7 @@ impl Problem for CondensedSystem<'_> {
                 }
             }
         }
+        let slopes = self.complementarity_slopes(x, &h);
         for (l, &jn) in fb.rows.iter().enumerate().filter(|(_, &r)| r < np) {
             let row = &mut buf[l * ncl..(l + 1) * ncl];
             let area = self.p_area[jn];
@@ -675,8 +704,13 @@ impl Problem for CondensedSystem<'_> {
             if let Some(c) = diag {
                 row[c] += self.params.penalty * area * penalty_slope(x[jn]);
             }
-            let s = self.row_scale[jn];
+            // Complementarity: phi(P, F) has the row d phi/dF dF/dx + d phi/dP e_j.
+            let (dp, df) = slopes[jn];
+            let s = self.row_scale[jn] * df;
             row.iter_mut().for_each(|v| *v *= s);
+            if let Some(c) = diag {
+                row[c] += dp;
+            }
         }
         if let Some(l) = fb.row_of(np as i32) {
             // Load row: integral of P.

@@ -16,7 +16,7 @@ use crate::reynolds::jump::{interior_edges, EdgeJump, JumpRows};
 use crate::solid::dofmap::DofMap;
 use mpi::topology::SimpleCommunicator;
 
-pub use crate::reynolds::cavitation::{clip_pressure_step, penalty_law, CAVITATION_SMOOTHING, PRESSURE_STEP_FLOOR};
+pub use crate::reynolds::cavitation::{clip_pressure_step, complementarity, penalty_law, CAVITATION_SMOOTHING, PRESSURE_STEP_FLOOR};
 
 /// The floor of a Newton step's nodal pressure ([`PRESSURE_STEP_FLOOR`]); the options
 /// `-ehl_pressure_step_floor VALUE` and `-ehl_pressure_step_clip false` change it.
@@ -74,11 +74,32 @@ pub struct EhlParams {
 impl EhlParams {
     /// A new operating point: the speed parameter and the cavitation penalty (which the
     /// SUPG strong residual carries too).
+    /// What is added to a Reynolds row's diagonal before it scales the row: 1e-6 xi. It caps
+    /// the scale of the contact's rows (diagonals down to 1e-11 under exp(alpha p)), whose
+    /// residual is a sum of O(1) terms: scaled by 1e11 its round-off alone is 1e-5. The
+    /// complementarity form has no xi and keeps the floor of the penalty solve at xi = 1e3
+    /// that starts it (without it Newton stalled at residual norms of 2e-6 on
+    /// cases/examples/barus-newtonian, and the Jacobian's norm was 4.8e7 instead of 2e3).
+    pub fn row_scale_floor(&self) -> f64 {
+        if self.stabilisation.complementarity {
+            1e-3
+        } else {
+            self.penalty * 1e-6
+        }
+    }
+
     pub fn set_operating(&mut self, lambda_bar: f64, penalty: f64) {
         self.lambda_bar = lambda_bar;
         self.penalty = penalty;
         self.stabilisation.penalty = penalty;
     }
+}
+
+/// The iterate of the last complementarity residual and, per owned P row, the
+/// complementarity function's derivatives in P and F there.
+struct Cavitated {
+    at: Vec<f64>,
+    slopes: Vec<(f64, f64)>,
 }
 
 /// One contact triangle as the Reynolds assembly sees it.
@@ -126,6 +147,9 @@ pub struct EhlSystem<'a> {
     jacobian_built: bool,
     /// Global P rows this rank owns (zeroed and refilled at each Jacobian).
     p_rows: Vec<i32>,
+    /// Complementarity cavitation: the iterate of the last residual and, per owned P row,
+    /// the complementarity function's derivatives in P and F there.
+    cavitated: Option<Cavitated>,
     u_work: Vector,
     ku_work: Vector,
     /// Counters for reports.
@@ -217,6 +241,7 @@ impl<'a> EhlSystem<'a> {
             penalty_nodes,
             jacobian_built: false,
             p_rows,
+            cavitated: None,
             u_work,
             ku_work,
             residual_evals: 0,
@@ -292,7 +317,9 @@ pub trait EhlProblem: Problem {
     /// speed parameter lambda_bar and the dimensionless lubricant laws. The elastic rows do
     /// not depend on it.
     /// The cavitation penalty xi enters the penalty rows and the SUPG strong residual.
-    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64);
+    /// The operating point: speed, lubricant, cavitation penalty xi and whether the
+    /// cavitation condition is the complementarity form.
+    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64, complementarity: bool);
     /// Scales each Reynolds row by the inverse of its Jacobian diagonal at `x` (held constant
     /// afterwards, so the Jacobian stays exact and the solution unchanged). The rows' natural
     /// sizes differ by ten orders of magnitude (eps ~ 1e4 at the inlet, ~1e-9 in the
@@ -332,8 +359,9 @@ impl EhlProblem for EhlSystem<'_> {
         true
     }
 
-    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64) {
+    fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64, complementarity: bool) {
         self.params.set_operating(lambda_bar, penalty);
+        self.params.stabilisation.complementarity = complementarity;
         self.lubricant = lubricant;
     }
 
@@ -360,7 +388,7 @@ impl EhlProblem for EhlSystem<'_> {
         for n in 0..self.mesh.nodes.len() {
             let d = self.layout.p[n];
             if d >= 0 {
-                let v = all[d as usize] + self.params.penalty * 1e-6;
+                let v = all[d as usize] + self.params.row_scale_floor();
                 self.row_scale.insert(d, if v > 0.0 { 1.0 / v } else { 1.0 });
             }
         }
@@ -451,6 +479,9 @@ impl Problem for EhlSystem<'_> {
         }
         let target = if self.rank == self.layout.ranges.len() - 2 { -self.params.load } else { 0.0 };
         f.set_values(&[self.layout.h0], &[load_part + target], true)?;
+        if self.params.stabilisation.complementarity {
+            self.complementarity_rows(x, f)?;
+        }
         if crate::ehl_options::get().monitor {
             f.assemble()?;
             let all = f.gather_all()?;
@@ -596,7 +627,58 @@ impl Problem for EhlSystem<'_> {
             }
         }
         self.jacobian_built = true;
+        if self.params.stabilisation.complementarity {
+            self.complementarity_jacobian(x, j)?;
+        }
         Ok(())
+    }
+}
+
+impl EhlSystem<'_> {
+    /// Replaces each owned Reynolds row's residual F_i by phi(P_i, F_i) (the cavitation
+    /// condition as complementarity, [`crate::reynolds::cavitation::complementarity`]) and
+    /// records phi's derivatives at `x` for the Jacobian. Assembles `f` (collective).
+    fn complementarity_rows(&mut self, x: &[f64], f: &Vector) -> Result<()> {
+        f.assemble()?;
+        let (lo, _) = f.ownership()?;
+        let mut vals = f.local_values()?;
+        let mut slopes = Vec::with_capacity(self.p_rows.len());
+        for &d in &self.p_rows {
+            let i = d as usize - lo;
+            let (v, dp, df) = crate::reynolds::cavitation::complementarity(x[d as usize], vals[i]);
+            vals[i] = v;
+            slopes.push((dp, df));
+        }
+        f.set_local_values(&vals)?;
+        self.cavitated = Some(Cavitated { at: x.to_vec(), slopes });
+        Ok(())
+    }
+
+    /// The Jacobian of the complementarity rows: d phi/dF times the Reynolds row plus
+    /// d phi/dP on the diagonal. Assembles `j` (collective).
+    fn complementarity_jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
+        if !self.cavitated.as_ref().is_some_and(|c| c.at.as_slice() == x) {
+            let f = Vector::new(crate::petsc::comm_world(), self.layout.local(self.rank))?;
+            f.set_all(0.0)?;
+            self.residual(x, &f)?;
+        }
+        j.assemble()?;
+        let slopes = &self.cavitated.as_ref().expect("set by the residual just evaluated").slopes;
+        let local = self.layout.local(self.rank);
+        let lo = self.layout.ranges[self.rank];
+        let mut scale = vec![1.0; local];
+        for (&d, &(_, df)) in self.p_rows.iter().zip(slopes) {
+            scale[d as usize - lo] = df;
+        }
+        let l = Vector::new(crate::petsc::comm_world(), local)?;
+        l.set_local_values(&scale)?;
+        pcall!(ffi::MatDiagonalScale(j.raw(), l.raw(), std::ptr::null_mut()))?;
+        // The P rows' own diagonal (MatDiagonalSet would also touch the load row, which has
+        // no diagonal entry).
+        for (&d, &(dp, _)) in self.p_rows.iter().zip(slopes) {
+            j.add_values(&[d], &[d], &[dp])?;
+        }
+        j.assemble()
     }
 }
 

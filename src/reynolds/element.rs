@@ -75,6 +75,10 @@ pub struct Stabilisation {
     /// Factor c_J of the gradient-jump term on the interior edges ([`super::jump`]; 0: off).
     /// The assembly adds it edge by edge; the element kernel does not see it.
     pub jump: f64,
+    /// Cavitation as the complementarity condition ([`super::cavitation::complementarity`]):
+    /// where the discrete pressure is not positive the exact solution's residual is the
+    /// cavitation multiplier, not zero, so SUPG drops its strong residual there.
+    pub complementarity: bool,
 }
 
 /// The terms of the SUPG strong residual r = div(rho_bar H v) - div(eps grad P) + penalty.
@@ -92,7 +96,17 @@ pub enum StrongResidual {
 impl Default for Stabilisation {
     /// SUPG on, delta = 1, full strong residual, Pe on |v|.
     fn default() -> Self {
-        Self { supg: true, delta: 1.0, id: 0.0, cd: 0.0, penalty: 0.0, residual: StrongResidual::Full, film_peclet: false, jump: 0.0 }
+        Self {
+            supg: true,
+            delta: 1.0,
+            id: 0.0,
+            cd: 0.0,
+            penalty: 0.0,
+            residual: StrongResidual::Full,
+            film_peclet: false,
+            jump: 0.0,
+            complementarity: false,
+        }
     }
 }
 
@@ -335,9 +349,10 @@ pub fn reynolds_element_with_source(
         }
 
         if stab.supg {
-            if vn == 0.0 {
-                continue; // the SUPG weight v . grad N_i vanishes
+            if vn == 0.0 || (stab.complementarity && pq.v <= 0.0) {
+                continue; // the SUPG weight v . grad N_i vanishes, or the film cavitates
             }
+            let gate = if stab.complementarity { super::cavitation::pressurised(pq) } else { D12::constant(1.0) };
             let mut pen = D12::constant(0.0);
             for j in 0..6 {
                 pen += pen_nodes[j] * n[j];
@@ -356,7 +371,7 @@ pub fn reynolds_element_with_source(
 
             // tau = delta h_e / (2|v|) xi(Pe), h_e = streamline length
             let tau = supg_tau(stab, vn, streamline_length(&tri, v), eps, drho_d, hq);
-            let t_r = tau * r_strong * wq;
+            let t_r = tau * r_strong * gate * wq;
             for i in 0..6 {
                 res[i] += t_r * v_dn[i];
             }

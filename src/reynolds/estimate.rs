@@ -15,6 +15,7 @@
 //! under-resolved. It is used to mark elements; the error of hc and hm is estimated from
 //! the change between refinement levels (see `app::adapt`).
 
+use super::cavitation::Cavitation;
 use super::dual::Dual;
 use super::element::{strong_residual, Fluid, PointFields, Stabilisation, StrongResidual};
 use crate::fem::p2tri::P2Triangle;
@@ -60,16 +61,16 @@ fn fields_at(tri: &P2Triangle, l: &[f64; 3], p: &[f64; 6], h: &[f64; 6], fluid: 
 }
 
 /// The indicator parts of one P2 triangle with nodal `p`, `h` (order v0, v1, v2, m01,
-/// m12, m20), entrainment velocity `vel` at the vertices (affine inside) and cavitation
-/// penalty factor `penalty` (0: none; the nodal penalty is interpolated as in the
-/// stabilised element).
+/// m12, m20), entrainment velocity `vel` at the vertices (affine inside) and the
+/// cavitation treatment `cavitation` (a nodal penalty is interpolated as in the stabilised
+/// element; with complementarity the residual counts where the film is pressurised).
 pub fn element_residual(
     verts: &[[f64; 2]; 3],
     p: &[f64; 6],
     h: &[f64; 6],
     vel: &[[f64; 2]; 3],
     fluid: &Fluid,
-    penalty: f64,
+    cavitation: Cavitation,
 ) -> ElementResidual {
     let tri = P2Triangle::new(verts);
     let mut lap_p = 0.0;
@@ -77,7 +78,10 @@ pub fn element_residual(
         lap_p += p[j] * tri.lap[j];
     }
     let div_v: f64 = (0..3).map(|k| vel[k][0] * tri.grad_l[k][0] + vel[k][1] * tri.grad_l[k][1]).sum();
-    let pen_nodes: [f64; 6] = std::array::from_fn(|j| if penalty > 0.0 { penalty * super::cavitation::penalty_law(p[j]).0 } else { 0.0 });
+    let pen_nodes: [f64; 6] = std::array::from_fn(|j| match cavitation {
+        Cavitation::Penalty(xi) => xi * super::cavitation::penalty_law(p[j]).0,
+        _ => 0.0,
+    });
     let stab = Stabilisation { residual: StrongResidual::Full, ..Stabilisation::default() };
     let mut interior = 0.0;
     for q in DUNAVANT6.iter() {
@@ -87,7 +91,13 @@ pub fn element_residual(
         let v = [0, 1].map(|c| l[0] * vel[0][c] + l[1] * vel[1][c] + l[2] * vel[2][c]);
         let pen: f64 = (0..6).map(|j| pen_nodes[j] * n[j]).sum();
         let r = strong_residual(&stab, &f, fluid.lambda_bar, D1::constant(lap_p), v, div_v, D1::constant(pen));
-        interior += q.w * tri.area * r.v.abs();
+        let weight = if cavitation == Cavitation::Complementarity {
+            let pq: f64 = (0..6).map(|j| p[j] * n[j]).sum();
+            super::cavitation::pressurised(D1::constant(pq)).v
+        } else {
+            1.0
+        };
+        interior += q.w * tri.area * r.v.abs() * weight;
     }
     // Outward normal of edge a -> b: (dz, -dx)/len for a counter-clockwise triangle in
     // (X, Z), the opposite for a clockwise one.
@@ -147,11 +157,11 @@ mod tests {
         // uniform, so every term of div(H v) - div(H^3 grad P / lambda) vanishes.
         let fluid = Fluid::constant(1.0);
         let vel = [[1.0, 0.0]; 3];
-        let r0 = element_residual(&TRI, &nodes(|x, z| x * x - z * z), &[1.0; 6], &vel, &fluid, 0.0);
+        let r0 = element_residual(&TRI, &nodes(|x, z| x * x - z * z), &[1.0; 6], &vel, &fluid, Cavitation::Off);
         assert!(r0.interior < 1e-13, "{}", r0.interior);
         // A film rising along the flow, H = 1 + X, with P = 0: r = dH/dX = 1, so
         // int |r| = area.
-        let r1 = element_residual(&TRI, &[0.0; 6], &nodes(|x, _| 1.0 + x), &vel, &fluid, 0.0);
+        let r1 = element_residual(&TRI, &[0.0; 6], &nodes(|x, _| 1.0 + x), &vel, &fluid, Cavitation::Off);
         assert!((r1.interior - 0.125).abs() < 1e-13, "{}", r1.interior);
     }
 
@@ -164,9 +174,9 @@ mod tests {
         let f = |x: f64, z: f64| 1.0 + x * z + 2.0 * x * x;
         let h = [0.7; 6];
         let vel = [[1.0, 0.0]; 3];
-        let a = element_residual(&TRI, &nodes(f), &h, &vel, &fluid, 0.0);
+        let a = element_residual(&TRI, &nodes(f), &h, &vel, &fluid, Cavitation::Off);
         let pb = crate::fem::p2tri::p2_tri_node_coords(&other).map(|q| f(q[0], q[1]));
-        let b = element_residual(&other, &pb, &h, &vel, &fluid, 0.0);
+        let b = element_residual(&other, &pb, &h, &vel, &fluid, Cavitation::Off);
         // TRI's edge 1 runs (0.5, 0) -> (0, 0.5), other's edge 1 the other way: the
         // points match in reverse order.
         for g in 0..2 {

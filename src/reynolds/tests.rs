@@ -562,3 +562,36 @@ fn a_pressure_step_stops_at_the_floor_and_leaves_other_steps_alone() {
     assert_eq!(clip_pressure_step(-0.2, -0.15, floor), -0.15);
     assert_eq!(clip_pressure_step(-0.2, 0.5, floor), 0.0);
 }
+
+/// With cavitation as complementarity SUPG leaves a cavitated element (P = 0 at every
+/// node, where the exact solution's residual is the cavitation multiplier) to plain
+/// Galerkin, and a pressurised one to the usual SUPG.
+#[test]
+fn complementarity_supg_leaves_a_cavitated_element_to_galerkin() {
+    // Convection-dominated (eps = H^3/lambda_bar ~ 1e-4): SUPG acts.
+    let fluid = fluid_exp_dh(1e4);
+    let verts = [[0.0, 0.0], [0.3, 0.05], [0.05, 0.25]];
+    let h = [1.0, 1.2, 1.1, 1.1, 1.15, 1.05];
+    let vel = [[1.0, 0.0]; 3];
+    let supg = production_supg();
+    let ncp = Stabilisation { complementarity: true, ..supg };
+    let cav = reynolds_element(&verts, &[0.0; 6], &h, &vel, &fluid, &ncp);
+    let gal = reynolds_element(&verts, &[0.0; 6], &h, &vel, &fluid, &Stabilisation::none());
+    let with_supg = reynolds_element(&verts, &[0.0; 6], &h, &vel, &fluid, &Stabilisation { penalty: 0.0, ..supg });
+    for i in 0..6 {
+        assert!((cav.r[i] - gal.r[i]).abs() < 1e-14, "row {i}: {} vs {}", cav.r[i], gal.r[i]);
+    }
+    let scale = gal.r.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    assert!(
+        (0..6).any(|i| (with_supg.r[i] - gal.r[i]).abs() > 1e-3 * scale),
+        "SUPG must act on this element without complementarity: {:?} vs {:?}",
+        with_supg.r,
+        gal.r
+    );
+    let p = [0.4, 0.5, 0.45, 0.47, 0.48, 0.42];
+    let a = reynolds_element(&verts, &p, &h, &vel, &fluid, &ncp);
+    let b = reynolds_element(&verts, &p, &h, &vel, &fluid, &supg);
+    for i in 0..6 {
+        assert!((a.r[i] - b.r[i]).abs() < 1e-14 * (1.0 + b.r[i].abs()), "row {i}");
+    }
+}

@@ -72,8 +72,15 @@ choice_enum! {
 choice_enum! {
     /// `effects.cavitation`: how p >= 0 is enforced.
     pub enum CavitationModel {
-        /// Penalty term -xi min(p, 0) (xi = `reynolds.penalty`).
+        /// Penalty term -xi min(p, 0) (xi = `reynolds.penalty`): p is held at -O(1/xi) where
+        /// the film cavitates, and the films carry an error that falls slowly with xi.
         Penalty = "penalty",
+        /// The Reynolds condition exactly: p >= 0, the Reynolds residual >= 0 and their
+        /// product 0 at every node, solved by semismooth Newton (Fischer-Burmeister) from a
+        /// penalty solution (xi = min(`reynolds.penalty`, 1e3)) or a coarser level's
+        /// pressure. The result does not depend on xi; on coarse meshes its SUPG term at the
+        /// cavitation boundary is not yet the penalty's (docs/numerics.md).
+        Complementarity = "complementarity",
         /// None: negative pressures are kept.
         Off = "none",
     } default = Penalty

@@ -79,8 +79,10 @@ pub struct ReynoldsDomain {
     pub z_min: f64,
     /// Side edge z_max/a, >= 1; default 3.
     pub z_max: f64,
-    /// Dimensionless cavitation penalty factor xi (> 0): the term -xi min(P, 0) is added
-    /// to the dimensionless Reynolds residual; default 1e4.
+    /// Dimensionless cavitation penalty factor xi (> 0): with `effects.cavitation =
+    /// "penalty"` the term -xi min(P, 0) is added to the dimensionless Reynolds residual;
+    /// with "complementarity" the first solve from the Hertz start uses it (at most 1e3);
+    /// default 1e4.
     pub penalty: f64,
     /// "supg" | "supg-exact" | "supg-couette" | "none"; default "supg".
     pub stabilisation: Stabilisation,
@@ -140,7 +142,8 @@ pub const REYNOLDS_FIELDS: &[Field] = &[
         note = "the rectangle must contain the Hertz circle and lie inside the top face: |z_min| < mesh.cube_size/2"),
     f!("z_max", "side edge of the Reynolds rectangle z_max/a", "a", Kind::Number(Range::AtLeast(1.0)), Presence::Default("3"),
         note = "the rectangle must contain the Hertz circle and lie inside the top face: z_max < mesh.cube_size/2"),
-    f!("penalty", "dimensionless cavitation penalty factor xi", "", Kind::Number(Range::Positive), Presence::Default("1e4")),
+    f!("penalty", "dimensionless cavitation penalty factor xi", "", Kind::Number(Range::Positive), Presence::Default("1e4"),
+        note = "the penalty model's xi; with effects.cavitation = \"complementarity\" only the first solve from the Hertz start uses it, at most 1e3, and the result does not depend on it"),
     f!("stabilisation", "stabilisation of the Reynolds equation", "", Kind::Choice(Stabilisation::NAMES),
         Presence::Default("\"supg\"")),
     f!("artificial_diffusion", "isotropic artificial diffusion factor delta_ID (eps_ID = delta_ID h_e |rho' H u|; 0 = off; experimental: inconsistent, changes the film)", "",

@@ -3,11 +3,12 @@
 //! start, the homotopies of [`homotopies`] are tried in order, each a scene parameter and
 //! a ramp: find a milder problem Newton solves from the start, then ramp the parameter back
 //! to the scene's value, each converged state starting the next solve. Last, a staged
-//! penalty is ramped from [`PENALTY_START`] to the scene's. Every Newton solve is logged and
-//! kept in the path.
+//! penalty is ramped from [`PENALTY_START`] to the scene's, or, with cavitation as
+//! complementarity, the complementarity form is solved from the penalty solution. Every
+//! Newton solve is logged and kept in the path.
 use super::diagnostics::Collapse;
 use super::policy::{newton_atol, set_newton_linear_solver, Policy, INTERMEDIATE_ATOL};
-use super::problem::{hc_guess, lambda_bar, lubricant, penalty, velocity_field};
+use super::problem::{complementarity, hc_guess, lambda_bar, lubricant, penalty, velocity_field};
 use super::start::RampLimits;
 use crate::case::Scene;
 use crate::context::Context;
@@ -358,7 +359,7 @@ impl Newton<'_> {
     /// finish after a stale LU included.
     fn solve_to_tolerance(&mut self, sc: &Scene, system: &mut dyn EhlProblem, start: &[f64]) -> Result<SolveReport, Error> {
         let (lo, hi) = self.owned;
-        system.set_operating(lambda_bar(sc), lubricant(sc), penalty(sc));
+        system.set_operating(lambda_bar(sc), lubricant(sc), penalty(sc), complementarity(sc));
         self.x.set_local_values(&start[lo..hi])?;
         if self.row_scaling {
             system.scale_rows(start)?;
@@ -643,8 +644,11 @@ impl<'s> RampSteps<'s> {
 /// Newton from `x0` (described by `label`) at the scene's operating point, as the policy
 /// says: with `stages_penalty`, a stiff cavitation penalty (xi > 1e3) is solved at xi = 1e3
 /// first; with `continues`, if that fails, the [`homotopies`] from a milder problem to the
-/// scene's (at xi = 1e3); last the penalty from 1e3 to the scene's xi. Returns the
-/// converged iterate (gathered) or an error naming the path taken.
+/// scene's (at xi = 1e3); last the penalty from 1e3 to the scene's xi. With cavitation as
+/// complementarity the Hertz start and the continuations solve the penalty problem at
+/// xi = 1e3 and then the complementarity form from its solution; another start solves the
+/// complementarity form at once. Returns the converged iterate (gathered) or an error
+/// naming the path taken.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn newton_with_continuation(
     ctx: &Context,
@@ -675,7 +679,8 @@ pub(super) fn newton_with_continuation(
         iterations: 0,
         bt_after_domain: policy.bt_after_domain_error(),
         reuses_lu: policy.reuses_lu,
-        scene_penalty: penalty(scene),
+        // With complementarity every penalty problem is short of the scene's.
+        scene_penalty: if complementarity(scene) { f64::INFINITY } else { penalty(scene) },
         trail: None,
         short_atol: (scene.accuracy.target > 0.0).then_some(INTERMEDIATE_ATOL.max(newton_atol(scene.accuracy.target))),
         atol: newton_atol(scene.accuracy.target),
@@ -690,24 +695,37 @@ pub(super) fn newton_with_continuation(
     // (a sweep) goes straight to the scene's xi ([`Policy::stages_penalty`]).
     let target = scene.operating.load;
     let xi = penalty(scene);
-    let staged = policy.stages_penalty && xi > PENALTY_START;
-    let mut base = scene.clone();
+    // The complementarity form of cavitation is solved from a converged state only: a
+    // coarser level's pressure, or this level's penalty solution at xi = 1e3 (its xi does
+    // not reach the result, so the penalty is not staged). From the Hertz start Newton on
+    // it closed the film on table2-ue2's first level, where the penalty converges in 8
+    // iterations (docs/numerics.md "Cavitation as complementarity").
+    let exact = complementarity(scene);
+    let mut relaxed = scene.clone();
+    if exact {
+        relaxed.effects.cavitation = crate::case::CavitationModel::Penalty;
+        relaxed.reynolds.penalty = scene.reynolds.penalty.min(PENALTY_START);
+    }
+    let staged = !exact && policy.stages_penalty && xi > PENALTY_START;
+    let mut base = if exact && policy.from_hertz { relaxed.clone() } else { scene.clone() };
     if staged {
         base.reynolds.penalty = PENALTY_START;
     }
+    // The state found is the penalty problem's, and the complementarity form is solved from it.
+    let mut from_relaxed = exact && policy.from_hertz;
     // 1. Plain Newton from the start at the base problem.
     // The last solve's report; none when plain Newton is skipped and no continuation step
     // gets to a solve.
     let mut last: Option<SolveReport> = None;
     let mut state: Option<Vec<f64>> = None;
     if policy.plain_first && !opts.skip_plain {
-        let mut report = nw.solve(&base, system, x0, staged)?;
+        let mut report = nw.solve(&base, system, x0, staged || from_relaxed)?;
         let at_xi = if staged { format!(", xi = {PENALTY_START:e}") } else { String::new() };
         nw.note(format!("Newton from {label} at L = {target} N{at_xi}: {} ({} iterations)", report.reason, report.iterations));
         nw.iterations = report.iterations;
         if policy.line_search == "bt" && bt_gave_out(&report, nw.collapse.is_some()) && !petsc::options::user_set("-snes_linesearch_type")?
         {
-            report = nw.on_with_l2(&base, system, staged, &report)?;
+            report = nw.on_with_l2(&base, system, staged || from_relaxed, &report)?;
         }
         if report.converged {
             state = Some(nw.solution()?);
@@ -722,6 +740,11 @@ pub(super) fn newton_with_continuation(
     // The continuation a coarser mesh's path went through is tried first, and even when it
     // is a last resort: that path shows it gets somewhere from this start.
     if state.is_none() && policy.continues {
+        // The continuations run on the penalty problem.
+        if exact {
+            base = relaxed.clone();
+            from_relaxed = true;
+        }
         let leads = |h: &Homotopy| milder.as_ref().is_some_and(|m| m.parameter == h.parameter.name());
         let mut list: Vec<Homotopy> = homotopies(scene, policy.from_hertz)
             .into_iter()
@@ -826,6 +849,23 @@ pub(super) fn newton_with_continuation(
             let mid = nw.trail.take().unwrap_or_default().into_iter().rfind(|(s, _)| *s < t).map(|(s, x)| (xi * s, x));
             StagedPenalty { base_xi: PENALTY_START, base_x, mid, xi: xi * t, scene_xi: xi }
         });
+    }
+    // 4. The complementarity form, from the penalty problem's solution, with the "l2" line
+    //    search (unless the user set one): "bt" refused every full step on table2-ue2's
+    //    0.25 a first level and crawled at its smallest step for 30 iterations, as from
+    //    another mesh's pressure ([`Policy::line_search`]).
+    if let Some(from) = state.take_if(|_| from_relaxed) {
+        let ls = if petsc::options::user_set("-snes_linesearch_type")? { policy.line_search } else { "l2" };
+        let r = nw.solve_with_line_search((ls, policy.line_search), scene, system, &from, false)?;
+        nw.iterations += r.iterations;
+        nw.note(format!(
+            "cavitation as complementarity, from the penalty solution at xi = {:e}: {} ({} iterations)",
+            relaxed.reynolds.penalty, r.reason, r.iterations
+        ));
+        if r.converged {
+            state = Some(nw.solution()?);
+        }
+        last = Some(r);
     }
     let (Some(xs), Some(last)) = (state, last.as_ref()) else {
         let end = match &last {

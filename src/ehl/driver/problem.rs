@@ -41,13 +41,21 @@ pub fn velocity_field(scene: &Scene) -> Box<dyn Fn(f64, f64) -> [f64; 2] + Send 
     Box::new(move |x: f64, z: f64| [kin.um(x * a, z * a) / ue, kin.wm(x * a, z * a) / ue])
 }
 
-/// The scene's cavitation penalty xi (0 without the penalty model).
+/// The scene's cavitation penalty xi (0 without the penalty model). The complementarity
+/// form has none: its partner of P is the Reynolds residual itself (at a penalty solution
+/// that residual is the penalty's force where the film cavitates, and Newton sets P = 0
+/// there; with the penalty kept, it is zero and Newton's first step went astray).
 pub(super) fn penalty(scene: &Scene) -> f64 {
     if scene.effects.cavitation == crate::case::CavitationModel::Penalty {
         scene.reynolds.penalty
     } else {
         0.0
     }
+}
+
+/// Whether the scene's cavitation condition is the complementarity form.
+pub(super) fn complementarity(scene: &Scene) -> bool {
+    scene.effects.cavitation == crate::case::CavitationModel::Complementarity
 }
 
 /// EHL parameters of the scene (dimensionless).
@@ -84,6 +92,7 @@ fn stabilisation(scene: &Scene, penalty: f64) -> crate::reynolds::element::Stabi
             _ => StrongResidual::FrozenLubricant,
         },
         film_peclet: true,
+        complementarity: complementarity(scene),
     }
 }
 
