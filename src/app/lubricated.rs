@@ -124,7 +124,7 @@ pub fn effects_report(scene: &Scene, half: bool) -> serde_json::Value {
     match e.cavitation {
         CavitationModel::Complementarity => simulated.push(format!(
             "cavitation: the Reynolds condition as complementarity (P >= 0, its residual >= 0, their product 0), from the penalty solution at xi = {}",
-            scene.reynolds.penalty.min(1e3)
+            driver::complementarity_start_penalty(scene)
         )),
         CavitationModel::Penalty => simulated.push(format!("cavitation: penalty, xi = {}", scene.reynolds.penalty)),
         CavitationModel::Off => skipped.push("cavitation (effects.cavitation = \"none\": negative pressures kept)".into()),

@@ -485,8 +485,7 @@ impl<'a> CondensedSystem<'a> {
 
 impl EhlProblem for CondensedSystem<'_> {
     fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64, complementarity: bool) {
-        self.params.set_operating(lambda_bar, penalty);
-        self.params.stabilisation.complementarity = complementarity;
+        self.params.set_operating(lambda_bar, penalty, complementarity);
         self.lubricant = lubricant;
     }
 

@@ -72,8 +72,6 @@ pub struct EhlParams {
 }
 
 impl EhlParams {
-    /// A new operating point: the speed parameter and the cavitation penalty (which the
-    /// SUPG strong residual carries too).
     /// What is added to a Reynolds row's diagonal before it scales the row: 1e-6 xi. It caps
     /// the scale of the contact's rows (diagonals down to 1e-11 under exp(alpha p)), whose
     /// residual is a sum of O(1) terms: scaled by 1e11 its round-off alone is 1e-5. The
@@ -88,9 +86,12 @@ impl EhlParams {
         }
     }
 
-    pub fn set_operating(&mut self, lambda_bar: f64, penalty: f64) {
+    /// A new operating point: the speed parameter, the cavitation penalty (which the SUPG
+    /// strong residual carries too) and whether cavitation is the complementarity form.
+    pub fn set_operating(&mut self, lambda_bar: f64, penalty: f64, complementarity: bool) {
         self.lambda_bar = lambda_bar;
         self.penalty = penalty;
+        self.stabilisation.complementarity = complementarity;
         self.stabilisation.penalty = penalty;
     }
 }
@@ -360,8 +361,7 @@ impl EhlProblem for EhlSystem<'_> {
     }
 
     fn set_operating(&mut self, lambda_bar: f64, lubricant: Lubricant, penalty: f64, complementarity: bool) {
-        self.params.set_operating(lambda_bar, penalty);
-        self.params.stabilisation.complementarity = complementarity;
+        self.params.set_operating(lambda_bar, penalty, complementarity);
         self.lubricant = lubricant;
     }
 
@@ -699,7 +699,7 @@ mod tests {
             velocity: Box::new(|_, _| [1.0, 0.0]),
             nu: 0.3,
         };
-        p.set_operating(2e-3, 1e3);
+        p.set_operating(2e-3, 1e3, false);
         assert_eq!((p.lambda_bar, p.penalty, p.stabilisation.penalty), (2e-3, 1e3, 1e3));
     }
 

@@ -274,12 +274,12 @@ fn parameter_derivative<S: Problem>(
     local: usize,
     param: Parameter,
 ) -> Result<Vec<f64>, Error> {
-    let (lambda, penalty) = (params(system).lambda_bar, params(system).penalty);
+    let (lambda, penalty, exact) = (params(system).lambda_bar, params(system).penalty, params(system).stabilisation.complementarity);
     let mut at = |step: f64| -> Result<Vec<f64>, Error> {
         let factor = step.exp();
         match param {
-            Parameter::Speed => params(system).set_operating(lambda * factor, penalty),
-            Parameter::Penalty => params(system).set_operating(lambda, penalty * factor),
+            Parameter::Speed => params(system).set_operating(lambda * factor, penalty, exact),
+            Parameter::Penalty => params(system).set_operating(lambda, penalty * factor, exact),
         }
         let f = Vector::new(petsc::comm_world(), local)?;
         f.set_all(0.0)?;
@@ -291,7 +291,7 @@ fn parameter_derivative<S: Problem>(
         }
     };
     let (plus, minus) = (at(PARAMETER_STEP), at(-PARAMETER_STEP));
-    params(system).set_operating(lambda, penalty);
+    params(system).set_operating(lambda, penalty, exact);
     let (plus, minus) = (plus?, minus?);
     Ok(plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * PARAMETER_STEP)).collect())
 }

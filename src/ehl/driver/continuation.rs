@@ -23,6 +23,12 @@ use crate::petsc::{self, Matrix, Vector};
 /// ring").
 const PENALTY_START: f64 = 1e3;
 
+/// The penalty xi of the penalty problem from whose solution the complementarity form of
+/// cavitation is solved: the scene's, at most [`PENALTY_START`].
+pub fn complementarity_start_penalty(scene: &Scene) -> f64 {
+    scene.reynolds.penalty.min(PENALTY_START)
+}
+
 /// A Newton solve with the LU reused that ran out of iterations with its residual below this
 /// fraction of the starting one is near the solution: exact Newton finishes it.
 const NEAR_SOLUTION: f64 = 1e-4;
@@ -704,7 +710,7 @@ pub(super) fn newton_with_continuation(
     let mut relaxed = scene.clone();
     if exact {
         relaxed.effects.cavitation = crate::case::CavitationModel::Penalty;
-        relaxed.reynolds.penalty = scene.reynolds.penalty.min(PENALTY_START);
+        relaxed.reynolds.penalty = complementarity_start_penalty(scene);
     }
     let staged = !exact && policy.stages_penalty && xi > PENALTY_START;
     let mut base = if exact && policy.from_hertz { relaxed.clone() } else { scene.clone() };
