@@ -22,6 +22,7 @@ use crate::mesh::Mesh;
 use crate::reynolds::cavitation::Cavitation;
 use crate::reynolds::estimate::{dorfler_mark, element_residual};
 use crate::reynolds::jump::{edge_terms, jump_coefficient, triangle_shares, EdgeJump};
+use crate::reynolds::multiplier::{FaceElement, Multipliers};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;
@@ -36,6 +37,9 @@ const PRESSURISED: f64 = 1e-2;
 /// triangles (one or two) and how many there are.
 type EdgeFluxes = ([f64; 2], [usize; 2], u8);
 
+/// A value at each of a triangle's three vertices (its corners, or the velocity there).
+type Corners = [[f64; 2]; 3];
+
 /// The indicator of every contact triangle of a converged level (on every rank: each holds
 /// the whole iterate).
 pub(super) fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
@@ -49,6 +53,36 @@ pub(super) fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
         crate::case::CavitationModel::Off => Cavitation::Off,
     };
     let n = mesh.contact_tris.len();
+    let element =
+        |k: usize| (mesh.contact_tri_xz(k), mesh.contact_tris[k].map(|n| fields.p_node(n)), mesh.contact_tris[k].map(|n| fields.h_node(n)));
+    let verts_vel: Vec<(Corners, Corners)> = (0..n)
+        .map(|k| {
+            let verts = mesh.contact_tri_xz(k);
+            (verts, verts.map(|x| vel(x[0], x[1])))
+        })
+        .collect();
+    // Under complementarity the interior residual is the stabilised element's: less the
+    // cavitation multiplier, measured as the Newton residual measures it.
+    let multipliers = (cavitation == Cavitation::Complementarity).then(|| {
+        let areas: Vec<f64> = verts_vel.iter().map(|(v, _)| crate::fem::p2tri::tri_area(v)).collect();
+        let mut m = Multipliers::new(&mesh.contact_tris, &areas);
+        let galerkin = crate::reynolds::element::Stabilisation {
+            supg: false,
+            id: scene.reynolds.artificial_diffusion,
+            cd: scene.reynolds.crosswind_diffusion,
+            ..Default::default()
+        };
+        m.evaluate(
+            n,
+            |k| {
+                let (_, p, h) = element(k);
+                FaceElement { nodes: &mesh.contact_tris[k], verts: &verts_vel[k].0, vel: &verts_vel[k].1, p, h }
+            },
+            &fluid,
+            &galerkin,
+        );
+        m
+    });
     let mut eta = vec![0.0; n];
     // Edge (low, high vertex id) -> outward fluxes at its Gauss points, ordered from the
     // low to the high vertex, summed over the two triangles that share it.
@@ -56,11 +90,9 @@ pub(super) fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
     // marking every rank meshes from, agree to the last bit.
     let mut jumps: BTreeMap<(u32, u32), EdgeFluxes> = BTreeMap::new();
     for (k, tri) in mesh.contact_tris.iter().enumerate() {
-        let verts = mesh.contact_tri_xz(k);
-        let p = tri.map(|n| fields.p_node(n));
-        let h = tri.map(|n| fields.h_node(n));
-        let v = verts.map(|x| vel(x[0], x[1]));
-        let r = element_residual(&verts, &p, &h, &v, &fluid, cavitation);
+        let (verts, p, h) = element(k);
+        let g = multipliers.as_ref().map(|m| m.of(tri));
+        let r = element_residual(&verts, &p, &h, &verts_vel[k].1, &fluid, cavitation, g.as_ref());
         eta[k] = r.interior;
         for e in 0..3 {
             let (a, b) = (tri[e], tri[(e + 1) % 3]);

@@ -15,8 +15,9 @@ use crate::fem::p2tri::{p2_tri_weights, tri_area};
 use crate::mesh::Mesh;
 use crate::petsc::snes::{Eval, Problem};
 use crate::petsc::{Matrix, Result, Vector};
-use crate::reynolds::element::{reynolds_element, ElementOut, Fluid};
+use crate::reynolds::element::{reynolds_element, reynolds_element_with_multiplier, ElementOut, Fluid};
 use crate::reynolds::jump::JumpRows;
+use crate::reynolds::multiplier::{FaceElement, Multipliers};
 use crate::solid::condense::Compliance;
 
 /// Numbering of the condensed unknowns: P in `comp.cols` order, then H0; rank r owns
@@ -61,6 +62,8 @@ impl CondensedLayout {
 struct Element {
     /// Face index of the 6 nodes.
     face: [usize; 6],
+    /// The same as the cavitation multiplier's node ids.
+    ids: [u32; 6],
     /// The pressure unknowns each of the 6 nodes takes its pressure from, with weights
     /// (unknown -1 or weight 0: none; the Dirichlet edges have no unknown): the node's own
     /// unknown with weight 1. Kept as a prolongation T (pressure unknowns to nodal
@@ -214,6 +217,11 @@ pub struct CondensedSystem<'a> {
     jumps: Vec<JumpRows>,
     /// Nodal area (a sixth of each P2 triangle at the node) of each pressure unknown.
     p_area: Vec<f64>,
+    /// The cavitation multipliers (face nodes as ids), when the scene's cavitation is the
+    /// complementarity form.
+    multipliers: Option<Multipliers>,
+    /// Each face node's pressure unknowns with weights (the elements' T, node by node).
+    face_t: Vec<[(i32, f64); 2]>,
     /// The block of the dense Jacobian this rank fills (default: its rows, all columns).
     fill: FillBlock,
     /// Rigid gap at each face node.
@@ -255,7 +263,15 @@ impl<'a> CondensedSystem<'a> {
                 node_area[f] += area / 6.0;
             }
             let t: [[(i32, f64); 2]; 6] = std::array::from_fn(|k| [(p[k], 1.0), (-1, 0.0)]);
-            let mut e = Element { face, t, verts, vel: verts.map(|v| (params.velocity)(v[0], v[1])), w: p2_tri_weights(area), mine: false };
+            let mut e = Element {
+                face,
+                ids: face.map(|f| f as u32),
+                t,
+                verts,
+                vel: verts.map(|v| (params.velocity)(v[0], v[1])),
+                w: p2_tri_weights(area),
+                mine: false,
+            };
             e.mine = e.any_dof(owned);
             elements.push(e);
         }
@@ -267,6 +283,17 @@ impl<'a> CondensedSystem<'a> {
                 JumpRows::new(edge, rows, c_j, &*params.velocity)
             })
             .collect();
+        let mut face_t = vec![[(-1, 0.0); 2]; comp.rows.len()];
+        for e in &elements {
+            for k in 0..6 {
+                face_t[e.face[k]] = e.t[k];
+            }
+        }
+        let multipliers = params.stabilisation.complementarity.then(|| {
+            let ids: Vec<[u32; 6]> = elements.iter().map(|e: &Element| e.ids).collect();
+            let areas: Vec<f64> = elements.iter().map(|e| tri_area(&e.verts)).collect();
+            Multipliers::new(&ids, &areas)
+        });
         let p_face: Vec<usize> = comp.cols.iter().map(|&n| layout.face_index[n as usize] as usize).collect();
         let p_area = p_face.iter().map(|&f| node_area[f]).collect();
         let fill = FillBlock::new((lo..layout.ranges[rank + 1]).collect(), (0..layout.total()).collect(), comp, layout.total());
@@ -282,6 +309,8 @@ impl<'a> CondensedSystem<'a> {
             elements,
             jumps,
             p_area,
+            multipliers,
+            face_t,
             fill,
             gap,
             row_scale,
@@ -387,7 +416,56 @@ impl<'a> CondensedSystem<'a> {
 
     /// Residual and Jacobian of one P2 element.
     fn eval(&self, e: &Element, p: &[f64; 6], h: &[f64; 6], fluid: &Fluid) -> ElementOut {
-        reynolds_element(&e.verts, p, h, &e.vel, fluid, &self.params.stabilisation)
+        let stab = &self.params.stabilisation;
+        match &self.multipliers {
+            Some(m) if stab.complementarity && stab.supg => {
+                reynolds_element_with_multiplier(&e.verts, p, h, &e.vel, fluid, stab, &m.of(&e.ids))
+            }
+            _ => reynolds_element(&e.verts, p, h, &e.vel, fluid, stab),
+        }
+    }
+
+    /// Element `e` with its fields, as the multiplier sees it.
+    fn face_element<'e>(x: &[f64], h: &[f64], e: &'e Element) -> FaceElement<'e> {
+        FaceElement { nodes: &e.ids, verts: &e.verts, vel: &e.vel, p: Self::element_p(x, e), h: e.face.map(|f| h[f]) }
+    }
+
+    /// Measures the nodal cavitation multipliers at `x` (film `h`) when SUPG needs them.
+    fn measure_multipliers(&mut self, x: &[f64], h: &[f64]) {
+        if !(self.params.stabilisation.complementarity && self.params.stabilisation.supg) {
+            return;
+        }
+        let Some(mut m) = self.multipliers.take() else { return };
+        let fluid = self.lubricant.fluid(self.params.lambda_bar);
+        m.evaluate(self.elements.len(), |t| Self::face_element(x, h, &self.elements[t]), &fluid, &self.params.stabilisation);
+        self.multipliers = Some(m);
+    }
+
+    /// The multiplier's part of element `e`'s rows (`dr_dm` from its output): calls
+    /// `add(row unknown, column face node, dR/dP, dR/dH)` with the rows projected on the
+    /// pressure unknowns and the columns left at face nodes.
+    fn chain_multiplier(
+        &self,
+        x: &[f64],
+        h: &[f64],
+        e: &Element,
+        dr_dm: &[[f64; 6]; 6],
+        fluid: &Fluid,
+        mut add: impl FnMut(i32, usize, f64, f64),
+    ) {
+        let Some(m) = &self.multipliers else { return };
+        m.chain(
+            &e.ids,
+            dr_dm,
+            |t| Self::face_element(x, h, &self.elements[t]),
+            fluid,
+            &self.params.stabilisation,
+            |i, f, dp, dh| {
+                for (d, w) in e.entries(i) {
+                    add(d, f as usize, w * dp, w * dh);
+                }
+            },
+        );
     }
 
     /// The element's 6 nodal pressures (T P on the element).
@@ -408,8 +486,8 @@ impl<'a> CondensedSystem<'a> {
         let np = self.layout.n_p;
         let mut cols: Vec<std::collections::BTreeSet<usize>> = vec![Default::default(); hi - lo];
         for e in self.elements.iter().filter(|e| e.mine) {
-            let dofs: Vec<i32> = e.dofs().collect();
-            for &r in &dofs {
+            let dofs: Vec<i32> = e.dofs().chain(self.multiplier_reach(e)).collect();
+            for r in e.dofs() {
                 let Some(l) = self.own_row(r) else { continue };
                 cols[l].insert(np);
                 cols[l].extend(dofs.iter().map(|&d| d as usize));
@@ -429,18 +507,49 @@ impl<'a> CondensedSystem<'a> {
         (d, o)
     }
 
+    /// The pressure unknowns of the triangles around an element's nodes: the reach of its
+    /// rows' Jacobian with the cavitation multiplier (none without it).
+    fn multiplier_reach<'s>(&'s self, e: &'s Element) -> impl Iterator<Item = i32> + 's {
+        self.multipliers.iter().flat_map(move |m| e.ids.iter().flat_map(move |&k| m.around(k))).flat_map(move |&t| self.elements[t].dofs())
+    }
+
     /// The Jacobian with rigid solids (H = H0 + gap): sparse, element by element.
     fn jacobian_rigid(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
         let np = self.layout.n_p;
         let (_, hi) = self.owned();
         let h = self.film(x);
+        self.measure_multipliers(x, &h);
         let fluid = self.fluid();
         let slopes = self.complementarity_slopes(x, &h);
+        let pattern = !j.is_assembled()?;
         j.zero()?;
         for e in self.elements.iter().filter(|e| e.mine) {
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
-            let pr = e.project(&self.eval(e, &p, &he, &fluid));
+            let out = self.eval(e, &p, &he, &fluid);
+            if pattern && self.multipliers.is_some() {
+                // The multiplier's whole reach, as zeros in the first fill: the pattern is
+                // fixed at the first assembly, and the cavitated set moves afterwards.
+                let reach: Vec<i32> = self.multiplier_reach(e).collect();
+                let zeros = vec![0.0; reach.len()];
+                for r in e.dofs().filter(|&r| self.own_row(r).is_some()) {
+                    j.add_values(&[r], &reach, &zeros)?;
+                }
+            }
+            let mut err = Ok(());
+            self.chain_multiplier(x, &h, e, &out.dr_dm, &fluid, |d, f, dp, dh| {
+                if self.own_row(d).is_none() || err.is_err() {
+                    return;
+                }
+                let s = self.row_scale[d as usize] * slopes[d as usize].1;
+                let (mut cols, mut vals): (Vec<i32>, Vec<f64>) =
+                    self.face_t[f].iter().filter(|&&(c, w)| c >= 0 && w != 0.0).map(|&(c, w)| (c, s * w * dp)).unzip();
+                cols.push(np as i32);
+                vals.push(s * dh);
+                err = j.add_values(&[d], &cols, &vals);
+            });
+            err?;
+            let pr = e.project(&out);
             for a in 0..pr.n {
                 let Some(_) = self.own_row(pr.dofs[a]) else { continue };
                 let r = pr.dofs[a] as usize;
@@ -551,6 +660,7 @@ impl Problem for CondensedSystem<'_> {
             return Ok(Eval::Domain(why));
         }
         let (lo, hi) = self.owned();
+        self.measure_multipliers(x, &h);
         let mut r = self.scaled_reynolds(x, &h, lo, hi);
         if self.params.stabilisation.complementarity {
             for j in self.owned_p() {
@@ -649,6 +759,7 @@ impl Problem for CondensedSystem<'_> {
         }
         let np = self.layout.n_p;
         let h = self.film(x);
+        self.measure_multipliers(x, &h);
         let fluid = self.fluid();
         let fb = &self.fill;
         let ncl = fb.cols.len();
@@ -660,7 +771,25 @@ impl Problem for CondensedSystem<'_> {
             }
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
-            let pr = e.project(&self.eval(e, &p, &he, &fluid));
+            let out = self.eval(e, &p, &he, &fluid);
+            self.chain_multiplier(x, &h, e, &out.dr_dm, &fluid, |d, f, dp, dh| {
+                let Some(l) = fb.row_of(d) else { return };
+                let row = &mut buf[l * ncl..(l + 1) * ncl];
+                for &(c, w) in self.face_t[f].iter().filter(|&&(c, w)| c >= 0 && w != 0.0) {
+                    if let Some(c) = fb.col_of(c) {
+                        row[c] += w * dp;
+                    }
+                }
+                if dh != 0.0 {
+                    for (a, c) in row.iter_mut().zip(fb.c_row(self.comp, f)) {
+                        *a -= dh * c;
+                    }
+                    if let Some(c) = h0_col {
+                        row[c] += dh;
+                    }
+                }
+            });
+            let pr = e.project(&out);
             for a in 0..pr.n {
                 let Some(l) = fb.row_of(pr.dofs[a]) else { continue };
                 let row = &mut buf[l * ncl..(l + 1) * ncl];

@@ -11,8 +11,9 @@ use crate::mesh::{Mesh, Partition};
 use crate::pcall;
 use crate::petsc::snes::{Eval, Problem};
 use crate::petsc::{ffi, Matrix, Result, Vector};
-use crate::reynolds::element::{reynolds_element, Fluid, Stabilisation};
+use crate::reynolds::element::{reynolds_element, reynolds_element_with_multiplier, ElementOut, Fluid, Stabilisation};
 use crate::reynolds::jump::{interior_edges, EdgeJump, JumpRows};
+use crate::reynolds::multiplier::{FaceElement, Multipliers};
 use crate::solid::dofmap::DofMap;
 use mpi::topology::SimpleCommunicator;
 
@@ -141,6 +142,9 @@ pub struct EhlSystem<'a> {
     /// Stiffness in the displacement-only numbering of `dofs` (for K U).
     stiffness: Matrix,
     elements: Vec<ContactElement>,
+    /// Every contact triangle (all ranks'), with the nodal cavitation multipliers measured
+    /// on them, when the scene's cavitation is the complementarity form.
+    face: Option<(Vec<ContactElement>, Multipliers)>,
     /// Gradient-jump terms of the interior contact edges whose first triangle is this rank's.
     jumps: Vec<JumpRows>,
     /// Nodal penalty weights (area of the node's share of its triangles) of owned P nodes.
@@ -179,11 +183,7 @@ impl<'a> EhlSystem<'a> {
         lubricant: Lubricant,
         stiffness: Matrix,
     ) -> Result<Self> {
-        let mut elements = Vec::new();
-        for (t, tri) in mesh.contact_tris.iter().enumerate() {
-            if part.tet_rank[mesh.contact_tri_tet[t] as usize] as usize != rank {
-                continue;
-            }
+        let element = |tri: &[u32; 6]| {
             let xz = |n: u32| {
                 let c = mesh.nodes[n as usize];
                 [c[0], c[2]]
@@ -191,8 +191,18 @@ impl<'a> EhlSystem<'a> {
             let verts = [xz(tri[0]), xz(tri[1]), xz(tri[2])];
             let vel = verts.map(|v| (params.velocity)(v[0], v[1]));
             let gap = tri.map(|n| Layout::gap(mesh.nodes[n as usize]));
-            elements.push(ContactElement { nodes: *tri, verts, vel, gap, area: tri_area(&verts) });
-        }
+            ContactElement { nodes: *tri, verts, vel, gap, area: tri_area(&verts) }
+        };
+        let elements = (0..mesh.contact_tris.len())
+            .filter(|&t| part.tet_rank[mesh.contact_tri_tet[t] as usize] as usize == rank)
+            .map(|t| element(&mesh.contact_tris[t]))
+            .collect();
+        let face = params.stabilisation.complementarity.then(|| {
+            let all: Vec<ContactElement> = mesh.contact_tris.iter().map(element).collect();
+            let areas: Vec<f64> = all.iter().map(|e| e.area).collect();
+            let multipliers = Multipliers::new(&mesh.contact_tris, &areas);
+            (all, multipliers)
+        });
         let c_j = params.stabilisation.jump;
         let jumps = jump_terms_of(mesh, c_j, |a| part.tet_rank[mesh.contact_tri_tet[a] as usize] as usize == rank)
             .into_iter()
@@ -238,6 +248,7 @@ impl<'a> EhlSystem<'a> {
             lubricant,
             stiffness,
             elements,
+            face,
             jumps,
             penalty_nodes,
             jacobian_built: false,
@@ -278,6 +289,33 @@ impl<'a> EhlSystem<'a> {
 
     fn fluid(&self) -> Fluid<'_> {
         self.lubricant.fluid(self.params.lambda_bar)
+    }
+
+    /// Contact triangle `e` with its fields at `x`, as the multiplier sees it.
+    fn face_element<'e>(&self, x: &[f64], e: &'e ContactElement) -> FaceElement<'e> {
+        FaceElement { nodes: &e.nodes, verts: &e.verts, vel: &e.vel, p: self.element_pressure(x, e), h: self.element_film(x, e) }
+    }
+
+    /// Measures the nodal cavitation multipliers at `x` when SUPG needs them (complementarity).
+    fn measure_multipliers(&mut self, x: &[f64]) {
+        if !(self.params.stabilisation.complementarity && self.params.stabilisation.supg) {
+            return;
+        }
+        let Some((all, mut m)) = self.face.take() else { return };
+        m.evaluate(all.len(), |t| self.face_element(x, &all[t]), &self.fluid(), &self.params.stabilisation);
+        self.face = Some((all, m));
+    }
+
+    /// The Reynolds element at `x`, with the cavitation multipliers when they are measured.
+    fn reynolds(&self, x: &[f64], e: &ContactElement, fluid: &Fluid) -> ElementOut {
+        let (p, h) = (self.element_pressure(x, e), self.element_film(x, e));
+        let stab = &self.params.stabilisation;
+        match &self.face {
+            Some((_, m)) if stab.complementarity && stab.supg => {
+                reynolds_element_with_multiplier(&e.verts, &p, &h, &e.vel, fluid, stab, &m.of(&e.nodes))
+            }
+            _ => reynolds_element(&e.verts, &p, &h, &e.vel, fluid, stab),
+        }
     }
 
     /// Writes the iterate's displacement block into the displacement-only work vector.
@@ -350,7 +388,7 @@ impl EhlProblem for EhlSystem<'_> {
     /// The tilt continuation on the monolithic coupling (as on the condensed one): the
     /// element velocities at the vertices are re-evaluated from the new field.
     fn set_velocity(&mut self, velocity: Box<dyn Fn(f64, f64) -> [f64; 2] + Send + Sync>) -> bool {
-        for e in &mut self.elements {
+        for e in self.elements.iter_mut().chain(self.face.iter_mut().flat_map(|(all, _)| all.iter_mut())) {
             e.vel = e.verts.map(|v| velocity(v[0], v[1]));
         }
         for t in &mut self.jumps {
@@ -423,6 +461,7 @@ impl Problem for EhlSystem<'_> {
         let base = self.layout.ranges[self.rank] as i32;
         let idx: Vec<i32> = (0..ku.len() as i32).map(|i| base + i).collect();
         f.set_values(&idx, &ku, true)?;
+        self.measure_multipliers(x);
         let fluid = self.fluid();
         let mut load_part = 0.0;
         for e in &self.elements {
@@ -437,8 +476,7 @@ impl Problem for EhlSystem<'_> {
             let w = p2_tri_weights(e.area);
             load_part += (0..6).map(|k| w[k] * p[k]).sum::<f64>();
             // Reynolds rows.
-            let h = self.element_film(x, e);
-            let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid, &self.params.stabilisation);
+            let out = self.reynolds(x, e, &fluid);
             let rows_p: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
             let r: [f64; 6] = std::array::from_fn(|i| out.r[i] * self.scale_of(rows_p[i]));
             f.set_values(&rows_p, &r, true)?;
@@ -575,6 +613,7 @@ impl Problem for EhlSystem<'_> {
 
     fn jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
         self.jacobian_evals += 1;
+        let first = !j.is_assembled()?;
         if !self.jacobian_built {
             j.zero()?;
             self.add_stiffness(j)?;
@@ -591,12 +630,39 @@ impl Problem for EhlSystem<'_> {
                 std::ptr::null_mut()
             ))?;
         }
+        self.measure_multipliers(x);
         let fluid = self.fluid();
         for e in &self.elements {
-            let p = self.element_pressure(x, e);
-            let h = self.element_film(x, e);
-            let out = reynolds_element(&e.verts, &p, &h, &e.vel, &fluid, &self.params.stabilisation);
+            let out = self.reynolds(x, e, &fluid);
             let rows_p: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
+            if let Some((all, m)) = &self.face {
+                // The multiplier's reach (two rings): explicit zeros in the first Jacobian
+                // keep the pattern, since the cavitated set moves between iterations.
+                if first {
+                    for t in e.nodes.iter().flat_map(|k| m.around(*k)) {
+                        let cols: Vec<i32> =
+                            all[*t].nodes.iter().flat_map(|&n| [self.layout.p[n as usize], self.layout.u[n as usize][1]]).collect();
+                        j.add_values(&rows_p, &cols, &vec![0.0; 6 * cols.len()])?;
+                    }
+                }
+                let sc: [f64; 6] = rows_p.map(|r| self.scale_of(r));
+                let mut err = Ok(());
+                m.chain(
+                    &e.nodes,
+                    &out.dr_dm,
+                    |t| self.face_element(x, &all[t]),
+                    &fluid,
+                    &self.params.stabilisation,
+                    |i, n, dp, dh| {
+                        let cols = [self.layout.p[n as usize], self.layout.u[n as usize][1], self.layout.h0];
+                        let vals = [sc[i] * dp, -sc[i] * dh, sc[i] * dh];
+                        if err.is_ok() {
+                            err = j.add_values(&rows_p[i..=i], &cols, &vals);
+                        }
+                    },
+                );
+                err?;
+            }
             let cols_uy: [i32; 6] = e.nodes.map(|n| self.layout.u[n as usize][1]);
             let sc: [f64; 6] = rows_p.map(|r| self.scale_of(r));
             // dR/dP

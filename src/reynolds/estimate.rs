@@ -63,7 +63,9 @@ fn fields_at(tri: &P2Triangle, l: &[f64; 3], p: &[f64; 6], h: &[f64; 6], fluid: 
 /// The indicator parts of one P2 triangle with nodal `p`, `h` (order v0, v1, v2, m01,
 /// m12, m20), entrainment velocity `vel` at the vertices (affine inside) and the
 /// cavitation treatment `cavitation` (a nodal penalty is interpolated as in the stabilised
-/// element; with complementarity the residual counts where the film is pressurised).
+/// element; with complementarity the residual counts where the film is pressurised, less
+/// the nodal cavitation multipliers `multiplier` as the stabilised element subtracts them,
+/// [`super::multiplier`]).
 pub fn element_residual(
     verts: &[[f64; 2]; 3],
     p: &[f64; 6],
@@ -71,6 +73,7 @@ pub fn element_residual(
     vel: &[[f64; 2]; 3],
     fluid: &Fluid,
     cavitation: Cavitation,
+    multiplier: Option<&[f64; 6]>,
 ) -> ElementResidual {
     let tri = P2Triangle::new(verts);
     let mut lap_p = 0.0;
@@ -78,8 +81,9 @@ pub fn element_residual(
         lap_p += p[j] * tri.lap[j];
     }
     let div_v: f64 = (0..3).map(|k| vel[k][0] * tri.grad_l[k][0] + vel[k][1] * tri.grad_l[k][1]).sum();
-    let pen_nodes: [f64; 6] = std::array::from_fn(|j| match cavitation {
-        Cavitation::Penalty(xi) => xi * super::cavitation::penalty_law(p[j]).0,
+    let pen_nodes: [f64; 6] = std::array::from_fn(|j| match (cavitation, multiplier) {
+        (Cavitation::Penalty(xi), _) => xi * super::cavitation::penalty_law(p[j]).0,
+        (Cavitation::Complementarity, Some(g)) => -(1.0 - super::cavitation::pressurised(D1::constant(p[j])).v) * g[j],
         _ => 0.0,
     });
     let stab = Stabilisation { residual: StrongResidual::Full, ..Stabilisation::default() };
@@ -157,11 +161,11 @@ mod tests {
         // uniform, so every term of div(H v) - div(H^3 grad P / lambda) vanishes.
         let fluid = Fluid::constant(1.0);
         let vel = [[1.0, 0.0]; 3];
-        let r0 = element_residual(&TRI, &nodes(|x, z| x * x - z * z), &[1.0; 6], &vel, &fluid, Cavitation::Off);
+        let r0 = element_residual(&TRI, &nodes(|x, z| x * x - z * z), &[1.0; 6], &vel, &fluid, Cavitation::Off, None);
         assert!(r0.interior < 1e-13, "{}", r0.interior);
         // A film rising along the flow, H = 1 + X, with P = 0: r = dH/dX = 1, so
         // int |r| = area.
-        let r1 = element_residual(&TRI, &[0.0; 6], &nodes(|x, _| 1.0 + x), &vel, &fluid, Cavitation::Off);
+        let r1 = element_residual(&TRI, &[0.0; 6], &nodes(|x, _| 1.0 + x), &vel, &fluid, Cavitation::Off, None);
         assert!((r1.interior - 0.125).abs() < 1e-13, "{}", r1.interior);
     }
 
@@ -174,9 +178,9 @@ mod tests {
         let f = |x: f64, z: f64| 1.0 + x * z + 2.0 * x * x;
         let h = [0.7; 6];
         let vel = [[1.0, 0.0]; 3];
-        let a = element_residual(&TRI, &nodes(f), &h, &vel, &fluid, Cavitation::Off);
+        let a = element_residual(&TRI, &nodes(f), &h, &vel, &fluid, Cavitation::Off, None);
         let pb = crate::fem::p2tri::p2_tri_node_coords(&other).map(|q| f(q[0], q[1]));
-        let b = element_residual(&other, &pb, &h, &vel, &fluid, Cavitation::Off);
+        let b = element_residual(&other, &pb, &h, &vel, &fluid, Cavitation::Off, None);
         // TRI's edge 1 runs (0.5, 0) -> (0, 0.5), other's edge 1 the other way: the
         // points match in reverse order.
         for g in 0..2 {

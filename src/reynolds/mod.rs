@@ -92,6 +92,7 @@ pub mod dual;
 pub mod element;
 pub mod estimate;
 pub mod jump;
+pub mod multiplier;
 
 #[cfg(test)]
 mod tests;

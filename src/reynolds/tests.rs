@@ -595,3 +595,156 @@ fn complementarity_supg_leaves_a_cavitated_element_to_galerkin() {
         assert!((a.r[i] - b.r[i]).abs() < 1e-14 * (1.0 + b.r[i].abs()), "row {i}");
     }
 }
+
+/// Under complementarity the SUPG strong residual subtracts the cavitated nodes' multiplier,
+/// a function of the element's unknowns through each node's own strong residual and its
+/// pressurised weight: the Jacobian stays exact on elements that straddle the cavitation
+/// boundary (nodal pressures inside and on both sides of the ramp).
+#[test]
+fn jacobian_matches_finite_differences_across_the_cavitation_boundary() {
+    let mut rng = Lcg(777);
+    let fluid = fluid_exp_dh(0.3);
+    let stab = Stabilisation { complementarity: true, ..production_supg() };
+    let stab = Stabilisation { penalty: 0.0, ..stab };
+    let mut worst: f64 = 0.0;
+    for _ in 0..20 {
+        let s = rng.range(0.1, 0.5);
+        let c = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
+        let verts = [
+            [c[0], c[1]],
+            [c[0] + s * rng.range(0.7, 1.3), c[1] + s * rng.range(-0.3, 0.3)],
+            [c[0] + s * rng.range(-0.3, 0.5), c[1] + s * rng.range(0.7, 1.3)],
+        ];
+        // Two nodes cavitated, two inside the ramp, two pressurised; every FD step stays on
+        // its side (1e-6 against distances of 1e-5 and more to 0 and PRESSURISED_RAMP).
+        let ramp = crate::reynolds::cavitation::PRESSURISED_RAMP;
+        let p: [f64; 6] = std::array::from_fn(|k| match k % 3 {
+            0 => -rng.range(1e-5, 1e-3),
+            1 => ramp * rng.range(0.05, 0.95),
+            _ => rng.range(0.01, 0.5),
+        });
+        let h: [f64; 6] = std::array::from_fn(|_| rng.range(0.3, 1.5));
+        let vel = rigid_vel(&verts, rng.range(0.2, 1.0), rng.range(-0.5, 0.5), rng.range(-2.0, 2.0));
+        worst = worst.max(fd_jacobian_error(&verts, &p, &h, &vel, &fluid, &stab));
+    }
+    assert!(worst < 1e-5, "Jacobian error {worst}");
+}
+
+/// The multiplier's chain rule: on a patch of P2 triangles straddling a cavitation boundary,
+/// the assembled residual with the measured multipliers has the Jacobian that the element
+/// derivatives plus [`Multipliers::chain`] give (central differences in every nodal P and H).
+#[test]
+fn the_multiplier_chain_rule_matches_finite_differences_on_a_patch() {
+    use crate::reynolds::element::reynolds_element_with_multiplier;
+    use crate::reynolds::multiplier::{FaceElement, Multipliers};
+    // A 3 x 3 grid of squares on [0, 0.6]^2, each cut into two P2 triangles.
+    let n = 3;
+    let s = 0.2;
+    let vid = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+    let mut xy: Vec<[f64; 2]> = (0..=n).flat_map(|i| (0..=n).map(move |j| [i as f64 * s, j as f64 * s])).collect();
+    let mut mids = std::collections::HashMap::new();
+    let mut mid = |a: u32, b: u32, xy: &mut Vec<[f64; 2]>| {
+        *mids.entry((a.min(b), a.max(b))).or_insert_with(|| {
+            let (p, q) = (xy[a as usize], xy[b as usize]);
+            xy.push([0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])]);
+            (xy.len() - 1) as u32
+        })
+    };
+    let mut tris: Vec<[u32; 6]> = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            for [a, b, c] in [[vid(i, j), vid(i + 1, j), vid(i + 1, j + 1)], [vid(i, j), vid(i + 1, j + 1), vid(i, j + 1)]] {
+                let (m0, m1, m2) = (mid(a, b, &mut xy), mid(b, c, &mut xy), mid(c, a, &mut xy));
+                tris.push([a, b, c, m0, m1, m2]);
+            }
+        }
+    }
+    let nn = xy.len();
+    let verts: Vec<[[f64; 2]; 3]> = tris.iter().map(|t| [xy[t[0] as usize], xy[t[1] as usize], xy[t[2] as usize]]).collect();
+    let vel: Vec<[[f64; 2]; 3]> = verts.iter().map(|v| v.map(|_| [1.0, 0.3])).collect();
+    let areas: Vec<f64> = verts.iter().map(crate::fem::p2tri::tri_area).collect();
+    let fluid = fluid_exp_dh(0.3);
+    let stab = Stabilisation { complementarity: true, penalty: 0.0, ..production_supg() };
+    // Pressurised for X < 0.3, cavitated beyond (P = -1e-4 .. 0), a band inside the ramp.
+    let mut rng = Lcg(4242);
+    let ramp = crate::reynolds::cavitation::PRESSURISED_RAMP;
+    let p0: Vec<f64> = xy
+        .iter()
+        .map(|c| {
+            if c[0] < 0.25 {
+                rng.range(0.05, 0.4)
+            } else if c[0] < 0.35 {
+                ramp * rng.range(0.1, 0.9)
+            } else {
+                -rng.range(1e-5, 1e-4)
+            }
+        })
+        .collect();
+    let h0: Vec<f64> = (0..nn).map(|_| rng.range(0.4, 1.2)).collect();
+    let mut mult = Multipliers::new(&tris, &areas);
+    let face =
+        |t: usize, p: &[f64], h: &[f64]| -> ([f64; 6], [f64; 6]) { (tris[t].map(|k| p[k as usize]), tris[t].map(|k| h[k as usize])) };
+    let residual = |p: &[f64], h: &[f64], mult: &mut Multipliers| -> Vec<f64> {
+        mult.evaluate(
+            tris.len(),
+            |t| {
+                let (pe, he) = face(t, p, h);
+                FaceElement { nodes: &tris[t], verts: &verts[t], vel: &vel[t], p: pe, h: he }
+            },
+            &fluid,
+            &stab,
+        );
+        let mut r = vec![0.0; nn];
+        for t in 0..tris.len() {
+            let (pe, he) = face(t, p, h);
+            let out = reynolds_element_with_multiplier(&verts[t], &pe, &he, &vel[t], &fluid, &stab, &mult.of(&tris[t]));
+            for k in 0..6 {
+                r[tris[t][k] as usize] += out.r[k];
+            }
+        }
+        r
+    };
+    // The Jacobian: element derivatives plus the multiplier's chain rule (columns: P then H).
+    let mut jac = vec![vec![0.0; 2 * nn]; nn];
+    residual(&p0, &h0, &mut mult);
+    for t in 0..tris.len() {
+        let (pe, he) = face(t, &p0, &h0);
+        let out = reynolds_element_with_multiplier(&verts[t], &pe, &he, &vel[t], &fluid, &stab, &mult.of(&tris[t]));
+        for i in 0..6 {
+            for k in 0..6 {
+                jac[tris[t][i] as usize][tris[t][k] as usize] += out.dr_dp[i][k];
+                jac[tris[t][i] as usize][nn + tris[t][k] as usize] += out.dr_dh[i][k];
+            }
+        }
+        let element = |u: usize| {
+            let (pu, hu) = face(u, &p0, &h0);
+            FaceElement { nodes: &tris[u], verts: &verts[u], vel: &vel[u], p: pu, h: hu }
+        };
+        mult.chain(&tris[t], &out.dr_dm, element, &fluid, &stab, |i, col, dp, dh| {
+            jac[tris[t][i] as usize][col as usize] += dp;
+            jac[tris[t][i] as usize][nn + col as usize] += dh;
+        });
+    }
+    let step = 1e-7;
+    let mut worst: f64 = 0.0;
+    let scale = jac.iter().flatten().fold(0.0f64, |a, b| a.max(b.abs()));
+    for c in 0..2 * nn {
+        let (mut pp, mut hp, mut pm, mut hm) = (p0.clone(), h0.clone(), p0.clone(), h0.clone());
+        if c < nn {
+            pp[c] += step;
+            pm[c] -= step;
+        } else {
+            hp[c - nn] += step;
+            hm[c - nn] -= step;
+        }
+        let (rp, rm) = (residual(&pp, &hp, &mut mult), residual(&pm, &hm, &mut mult));
+        for r in 0..nn {
+            worst = worst.max(((rp[r] - rm[r]) / (2.0 * step) - jac[r][c]).abs() / scale);
+        }
+    }
+    assert!(worst < 1e-6, "Jacobian error {worst} (of the largest entry {scale})");
+    // The multiplier is in play: some row depends on a node outside its own triangles.
+    let reach =
+        (0..nn).any(|r| (0..nn).any(|c| jac[r][c] != 0.0 && !tris.iter().any(|t| t.contains(&(r as u32)) && t.contains(&(c as u32)))));
+    assert!(reach, "no row reaches beyond its triangles: the multiplier did not act");
+}

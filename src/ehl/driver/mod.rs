@@ -298,7 +298,17 @@ fn solve_condensed(
             let (p, hc) = start.pressure(scene);
             x0 = state_of(&system, p, hc)?;
             if comp.is_rigid() && matches!(start, Start::Hertz) {
-                rigid_start(ctx, &mut system, &mut x0, (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]), cl.local(ctx.rank))?;
+                // Under complementarity the frozen-film solves cross from P = 0 everywhere
+                // with the penalty that starts the complementarity solve (as the Hertz
+                // start does), not with the complementarity form itself.
+                let complementarity = system.params.stabilisation.complementarity;
+                let (lambda_bar, penalty) = (system.params.lambda_bar, system.params.penalty);
+                if complementarity {
+                    system.set_operating(lambda_bar, lubricant(scene), continuation::complementarity_start_penalty(scene), false);
+                }
+                let started = rigid_start(ctx, &mut system, &mut x0, (cl.ranges[ctx.rank], cl.ranges[ctx.rank + 1]), cl.local(ctx.rank));
+                system.set_operating(lambda_bar, lubricant(scene), penalty, complementarity);
+                started?;
                 "the rigid start"
             } else {
                 start.label()
@@ -474,7 +484,7 @@ fn solve_monolithic<'a>(
     };
     let label = start.label();
     let params = ehl_params(scene, eq.nu, half);
-    let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank, params.stabilisation.jump > 0.0);
+    let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank, params.stabilisation.jump > 0.0, params.stabilisation.complementarity);
     let j = Matrix::new_aij(comm, layout.local(ctx.rank), &d_nnz, &o_nnz)?;
     let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, params, lubricant(scene), k)?;
     let assembly_s = t0.elapsed().as_secs_f64();
