@@ -53,8 +53,7 @@ pub(super) fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
         crate::case::CavitationModel::Off => Cavitation::Off,
     };
     let n = mesh.contact_tris.len();
-    let element =
-        |k: usize| (mesh.contact_tri_xz(k), mesh.contact_tris[k].map(|n| fields.p_node(n)), mesh.contact_tris[k].map(|n| fields.h_node(n)));
+    let nodal = |k: usize| (mesh.contact_tris[k].map(|n| fields.p_node(n)), mesh.contact_tris[k].map(|n| fields.h_node(n)));
     let verts_vel: Vec<(Corners, Corners)> = (0..n)
         .map(|k| {
             let verts = mesh.contact_tri_xz(k);
@@ -66,20 +65,16 @@ pub(super) fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
     let multipliers = (cavitation == Cavitation::Complementarity).then(|| {
         let areas: Vec<f64> = verts_vel.iter().map(|(v, _)| crate::fem::p2tri::tri_area(v)).collect();
         let mut m = Multipliers::new(&mesh.contact_tris, &areas);
-        let galerkin = crate::reynolds::element::Stabilisation {
-            supg: false,
-            id: scene.reynolds.artificial_diffusion,
-            cd: scene.reynolds.crosswind_diffusion,
-            ..Default::default()
-        };
+        // The multiplier is measured with the Galerkin part alone (no penalty under
+        // complementarity).
         m.evaluate(
             n,
             |k| {
-                let (_, p, h) = element(k);
+                let (p, h) = nodal(k);
                 FaceElement { nodes: &mesh.contact_tris[k], verts: &verts_vel[k].0, vel: &verts_vel[k].1, p, h }
             },
             &fluid,
-            &galerkin,
+            &driver::stabilisation(scene, 0.0),
         );
         m
     });
@@ -90,9 +85,9 @@ pub(super) fn indicators(scene: &Scene, fields: &FieldsOnFace) -> Vec<f64> {
     // marking every rank meshes from, agree to the last bit.
     let mut jumps: BTreeMap<(u32, u32), EdgeFluxes> = BTreeMap::new();
     for (k, tri) in mesh.contact_tris.iter().enumerate() {
-        let (verts, p, h) = element(k);
+        let (p, h) = nodal(k);
         let g = multipliers.as_ref().map(|m| m.of(tri));
-        let r = element_residual(&verts, &p, &h, &verts_vel[k].1, &fluid, cavitation, g.as_ref());
+        let r = element_residual(&verts_vel[k].0, &p, &h, &verts_vel[k].1, &fluid, cavitation, g.as_ref());
         eta[k] = r.interior;
         for e in 0..3 {
             let (a, b) = (tri[e], tri[(e + 1) % 3]);

@@ -97,6 +97,8 @@ impl Multipliers {
         mut add: impl FnMut(usize, u32, f64, f64),
     ) {
         let galerkin = galerkin_part(stab);
+        // Neighbouring nodes share triangles: each triangle's Galerkin derivatives once.
+        let mut done: Vec<(usize, ElementOut)> = Vec::new();
         for (k, &node) in nodes.iter().enumerate() {
             if (0..6).all(|i| dr_dm[i][k] == 0.0) {
                 continue;
@@ -105,7 +107,14 @@ impl Multipliers {
             for &t in &self.around[&node] {
                 let e = element(t);
                 let Some(row) = e.nodes.iter().position(|&m| m == node) else { continue };
-                let out: ElementOut = reynolds_element(e.verts, &e.p, &e.h, e.vel, fluid, &galerkin);
+                let at = match done.iter().position(|(u, _)| *u == t) {
+                    Some(at) => at,
+                    None => {
+                        done.push((t, reynolds_element(e.verts, &e.p, &e.h, e.vel, fluid, &galerkin)));
+                        done.len() - 1
+                    }
+                };
+                let out = &done[at].1;
                 for i in 0..6 {
                     let c = dr_dm[i][k] * inv_area;
                     if c == 0.0 {

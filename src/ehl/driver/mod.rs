@@ -21,7 +21,7 @@ pub use adjoint::{film_derivative, Adjoint, Parameter};
 pub use diagnostics::{check_jacobian, POLE_COLLAPSE};
 use policy::Attempt;
 pub use policy::{set_newton_defaults, set_newton_linear_solver, Coupling, CONDENSED_PREFIX};
-pub use problem::{lambda_bar, lubricant, velocity_field};
+pub use problem::{lambda_bar, lubricant, stabilisation, velocity_field};
 pub use start::{Coarser, Milder, RampLimits, Start, Tries};
 
 use super::condensed::CondensedSystem;

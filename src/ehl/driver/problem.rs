@@ -72,8 +72,9 @@ pub(super) fn ehl_params(scene: &Scene, nu: f64, half: bool) -> EhlParams {
     }
 }
 
-/// The Reynolds element's stabilisation for the scene's `reynolds.stabilisation`.
-fn stabilisation(scene: &Scene, penalty: f64) -> crate::reynolds::element::Stabilisation {
+/// The Reynolds element's stabilisation for the scene's `reynolds.stabilisation`, with the
+/// cavitation penalty `penalty` in its strong residual.
+pub fn stabilisation(scene: &Scene, penalty: f64) -> crate::reynolds::element::Stabilisation {
     use crate::case::Stabilisation as S;
     use crate::reynolds::element::{Stabilisation, StrongResidual};
     let choice = scene.reynolds.stabilisation;
