@@ -30,7 +30,7 @@
 //!    triangle at the smallest size), the
 //!    last level's result is written with its estimated error, `accuracy.reached` is
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
-use super::estimate::{raised_penalty, Estimate, PenaltyError, PenaltySlopes, SHORT_PENALTY_SHARE};
+use super::estimate::{penalty_in_the_way, Estimate, PenaltyError, PenaltySlopes, SHORT_PENALTY_SHARE};
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, PointResult, Setup};
 use super::marking::{
@@ -38,7 +38,7 @@ use super::marking::{
 };
 use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
-use crate::case::Scene;
+use crate::case::{CavitationModel, Scene};
 use crate::collective;
 use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, RampLimits, Start, Tries};
 use crate::ehl::post::FieldsOnFace;
@@ -137,8 +137,9 @@ struct Solved {
     exponents: Option<serde_json::Value>,
     /// The gradient-jump factor the level was solved with (it may be raised after it).
     gradient_jump: f64,
-    /// The cavitation penalty the level was solved for (it may be raised after it).
-    penalty: f64,
+    /// The cavitation model the level was solved with (complementarity may take over after
+    /// it).
+    cavitation: CavitationModel,
     /// The marking of the next level (None on the last).
     marking: Option<Marking>,
     /// The level's friction pass, which the result's post-processing reports (a second
@@ -262,7 +263,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 None => format!("level {k} would have {n} unknowns, above accuracy.max_unknowns = {}", acc.max_unknowns),
             };
             let ranked = prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| over.len() < MAX_CUTS);
-            let hopeful = ranked.is_some() && Estimate::cut_could_reach(&levels, target);
+            let hopeful =
+                ranked.is_some() && Estimate::cut_could_reach(&levels, target, scene.effects.cavitation == CavitationModel::Penalty);
             if let Some((m, marked)) = ranked.filter(|_| hopeful) {
                 over.push((cut.map_or(marked, |c| c.count), n));
                 let count = cut_count(before, &over, budget);
@@ -304,7 +306,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         };
         // The adjoint after the level solves on Newton's last factorisation.
         // The complementarity form has no penalty error to estimate.
-        let penalised = scene.effects.cavitation == crate::case::CavitationModel::Penalty;
+        let penalised = scene.effects.cavitation == CavitationModel::Penalty;
         solver.keep_newton(acc.marking > 0.0 || scene.output.speed_exponents || penalised);
         // A staged penalty that stalls short of the scene's is judged by its error here.
         solver.accept_short_penalty(true);
@@ -665,7 +667,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             condensation_s,
             exponents,
             gradient_jump: scene.reynolds.gradient_jump,
-            penalty: scene.reynolds.penalty,
+            cavitation: scene.effects.cavitation,
             marking: marked,
             friction,
         };
@@ -699,18 +701,18 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
         }
         // The mesh's refinement cannot take the penalty's own error below the target: a
-        // penalty part above a quarter of it, once the mesh's part is below it, raises the
-        // penalty tenfold for the levels after (docs/accuracy.md, "The cavitation penalty's
-        // own error").
-        let raise = levels.last().and_then(|l| l.penalty.and_then(|p| raised_penalty(&p, l.est.as_ref(), target).map(|xi| (p, xi))));
-        if let Some((p, xi)) = raise {
+        // penalty part above a quarter of it, once the mesh's part is below it, has the
+        // levels after solve the Reynolds condition as complementarity, which has no such
+        // part (docs/accuracy.md, "The cavitation penalty's own error").
+        let in_the_way = levels.last().and_then(|l| l.penalty.filter(|p| penalty_in_the_way(p, l.est.as_ref(), target)));
+        if let Some(p) = in_the_way.filter(|_| own.effects.cavitation == CavitationModel::Penalty) {
             ctx.log(format!(
-                "accuracy: the cavitation penalty's part of the estimate (hc {:.3} %, hm {:.3} %) is above a quarter of the target, the mesh's part below it; reynolds.penalty raised from {:e} to {xi:e} for the levels after level {k}",
+                "accuracy: the cavitation penalty's part of the estimate (hc {:.3} %, hm {:.3} %{}) is above a quarter of the target, the mesh's part below it; the levels after level {k} solve cavitation as complementarity (effects.cavitation = \"complementarity\"), which has no such part",
                 100.0 * p.hc,
                 100.0 * p.hm,
-                p.scene_xi
+                p.friction.map_or(String::new(), |[fx, fz]| format!(", fx {:.3} %, fz {:.3} %", 100.0 * fx, 100.0 * fz)),
             ));
-            own.reynolds.penalty = xi;
+            own.effects.cavitation = CavitationModel::Complementarity;
         }
         previous = Some(here);
     }
@@ -855,7 +857,7 @@ fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Le
     // The scene written with the result is the one its level was solved with.
     let mut scene = scene.clone();
     scene.reynolds.gradient_jump = done.gradient_jump;
-    scene.reynolds.penalty = done.penalty;
+    scene.effects.cavitation = done.cavitation;
     let scene = &scene;
     let point = ctx.write_results(|dir| {
         let point = post_point(ctx, scene, &done.setup, &done.sol, done.condensation_s, done.friction.clone(), dir)?;

@@ -55,28 +55,23 @@ pub const FASTEST_PENALTY_ORDER: f64 = 1.0;
 pub const SHORT_PENALTY_SHARE: f64 = 0.5;
 
 /// A level whose penalty part of the estimate is above this share of the target has the
-/// penalty raised tenfold for the levels after it ([`raised_penalty`]): refining the mesh
-/// does not take that part down.
-pub const PENALTY_RAISE_SHARE: f64 = 0.25;
+/// levels after it solved with cavitation as complementarity ([`penalty_in_the_way`]):
+/// refining the mesh does not take that part down, and complementarity has none.
+pub const PENALTY_SWITCH_SHARE: f64 = 0.25;
 
-/// The largest cavitation penalty the adaptive loop raises a scene's to (three decades above
-/// the default 1e4).
-pub const MAX_RAISED_PENALTY: f64 = 1e7;
-
-/// The cavitation penalty for the levels after one whose penalty error is `p` and whose
-/// estimate is `est` (the penalty's part included), when it is to be raised: ten times the
-/// level's xi when the penalty's part is above [`PENALTY_RAISE_SHARE`] of `target` while
-/// the mesh's part (the rest of the estimate) is below the target, up to
-/// [`MAX_RAISED_PENALTY`]. Only then does the penalty stand in the way: on coarse levels
-/// the penalty's part is large and falls with the mesh (M = 1323: hm's 236 % on the first
-/// level, 0.6 % on the second; raised from there, the run took 205 s against 87 s for the
-/// same films). Not after a level whose ramp stalled short of its xi: a larger one would
-/// stall sooner.
-pub fn raised_penalty(p: &PenaltyError, est: Option<&Estimate>, target: f64) -> Option<f64> {
-    let raised = 10.0 * p.scene_xi;
+/// Whether the cavitation penalty's own error stands between a level (penalty error `p`,
+/// estimate `est` with the penalty's part included) and `target`, so that the levels after
+/// it are to solve the Reynolds condition as complementarity: when the penalty's part of
+/// some value is above [`PENALTY_SWITCH_SHARE`] of `target` while the mesh's part (the rest
+/// of the estimate) is below the target. Only then does the penalty stand in the way: on
+/// coarse levels the penalty's part is large and falls with the mesh (M = 1323: hm's 236 %
+/// on the first level, 0.6 % on the second). Raising xi instead takes the part down by only
+/// a third per decade (orders 0.15-0.45 in xi; docs/accuracy.md, "The cavitation penalty's
+/// own error").
+pub fn penalty_in_the_way(p: &PenaltyError, est: Option<&Estimate>, target: f64) -> bool {
     let mesh_within = est.is_some_and(|e| e.mesh_part() < target);
     let part = p.parts().into_iter().fold(0.0, f64::max);
-    (mesh_within && !p.short() && part > PENALTY_RAISE_SHARE * target && raised <= MAX_RAISED_PENALTY).then_some(raised)
+    mesh_within && part > PENALTY_SWITCH_SHARE * target
 }
 
 /// The estimated relative error left at the last penalty of a value with values `qs` at the
@@ -293,9 +288,11 @@ impl Estimate {
     /// Whether a level cut to the budget after the last of `levels` could bring every
     /// estimate below `target` ([`least_after_cut`]): when not, it is not solved (on
     /// cases/hard/spin-0.33deg it cost 800 s and moved fx's estimate from 1.31 % to 1.29 %).
-    pub(super) fn cut_could_reach(levels: &[Level], target: f64) -> bool {
+    /// The last level's penalty part counts only when the cut level is solved with the
+    /// penalty too (`penalised`): after the switch to complementarity it has none.
+    pub(super) fn cut_could_reach(levels: &[Level], target: f64, penalised: bool) -> bool {
         let halvings = halvings(levels);
-        let penalty = levels.last().and_then(|l| l.penalty).map_or(vec![], |p| p.parts());
+        let penalty = levels.last().and_then(|l| l.penalty).filter(|_| penalised).map_or(vec![], |p| p.parts());
         sequences(levels)
             .iter()
             .enumerate()
@@ -582,7 +579,7 @@ mod tests {
     }
 
     #[test]
-    fn the_penalty_is_raised_while_its_part_is_above_a_quarter_of_the_target() {
+    fn complementarity_takes_over_while_the_penalty_part_is_above_a_quarter_of_the_target() {
         let at = |xi: f64, hm: f64| penalty_at(xi, 1e4, hm);
         // The mesh's part of hm 0.06 %, below the target 0.001.
         let est = |p: &PenaltyError| Estimate {
@@ -593,30 +590,27 @@ mod tests {
             friction_penalty: None,
         };
         let p = at(1e4, 7.5e-4);
-        assert_eq!(raised_penalty(&p, Some(&est(&p)), 0.001), Some(1e5));
+        assert!(penalty_in_the_way(&p, Some(&est(&p)), 0.001));
         // Not while the mesh's part is above the target, nor on a first level (no estimate).
         let coarse = Estimate { hm: 3e-3 + p.hm, ..est(&p) };
-        assert_eq!(raised_penalty(&p, Some(&coarse), 0.001), None);
-        assert_eq!(raised_penalty(&p, None, 0.001), None);
-        // A quarter of the target or less, or a ramp that stalled short of its xi: kept.
+        assert!(!penalty_in_the_way(&p, Some(&coarse), 0.001));
+        assert!(!penalty_in_the_way(&p, None, 0.001));
+        // A quarter of the target or less: the penalty stays.
         let small = at(1e4, 2.5e-4);
-        assert_eq!(raised_penalty(&small, Some(&est(&small)), 0.001), None);
-        let short = at(2.4e3, 2.4e-3);
-        assert_eq!(raised_penalty(&short, Some(&est(&short)), 0.01), None);
-        // Not beyond the largest raised penalty.
-        let top = penalty_at(MAX_RAISED_PENALTY, MAX_RAISED_PENALTY, 1e-3);
-        assert_eq!(raised_penalty(&top, Some(&est(&top)), 0.001), None);
-        // A scene whose penalty was not staged (1e3) is raised to 1e4 like any other.
+        assert!(!penalty_in_the_way(&small, Some(&est(&small)), 0.001));
+        // A level whose ramp stalled short of its xi, or whose penalty was not staged, too.
+        let short = at(2.4e3, 4e-3);
+        assert!(penalty_in_the_way(&short, Some(&est(&short)), 0.01));
         let unstaged = penalty_at(1e3, 1e3, 7.5e-4);
-        assert_eq!(raised_penalty(&unstaged, Some(&est(&unstaged)), 0.001), Some(1e4));
-        // The friction's penalty part raises it too; the friction's mesh part holds it back.
+        assert!(penalty_in_the_way(&unstaged, Some(&est(&unstaged)), 0.001));
+        // The friction's penalty part counts too; the friction's mesh part holds it back.
         let with_friction = |fx_mesh: f64| {
             let p = PenaltyError { friction: Some([8e-4, 0.0]), ..penalty_at(1e4, 1e4, 1e-4) };
             let e = Estimate { friction: Some([fx_mesh + 8e-4, 0.0]), friction_penalty: p.friction, ..est(&p) };
-            raised_penalty(&p, Some(&e), 0.001)
+            penalty_in_the_way(&p, Some(&e), 0.001)
         };
-        assert_eq!(with_friction(1e-4), Some(1e5));
-        assert_eq!(with_friction(2e-3), None);
+        assert!(with_friction(1e-4));
+        assert!(!with_friction(2e-3));
     }
 
     #[test]

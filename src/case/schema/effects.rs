@@ -78,8 +78,10 @@ choice_enum! {
         /// The Reynolds condition exactly: p >= 0, the Reynolds residual >= 0 and their
         /// product 0 at every node, solved by semismooth Newton (Fischer-Burmeister) from a
         /// penalty solution (xi = min(`reynolds.penalty`, 1e3)) or a coarser level's
-        /// pressure. The result does not depend on xi; on coarse meshes its SUPG term at the
-        /// cavitation boundary is not yet the penalty's (docs/numerics.md).
+        /// pressure. The result does not depend on xi, and SUPG subtracts the cavitation
+        /// multiplier where the film cavitates (docs/numerics.md). A penalty scene refined
+        /// to a target switches to it once the penalty's own error stands in the way
+        /// (docs/accuracy.md).
         Complementarity = "complementarity",
         /// None: negative pressures are kept.
         Off = "none",
@@ -136,7 +138,7 @@ pub struct Effects {
     pub kinematics: KinematicsModel,
     /// "ree-eyring" | "newtonian" | "none"; default "ree-eyring".
     pub friction: FrictionModel,
-    /// "penalty" | "none"; default "penalty".
+    /// "penalty" | "complementarity" | "none"; default "penalty".
     pub cavitation: CavitationModel,
     /// "auto" | "off"; default "auto".
     pub symmetry: SymmetryMode,
