@@ -486,7 +486,7 @@ impl<'a> CondensedSystem<'a> {
         let np = self.layout.n_p;
         let mut cols: Vec<std::collections::BTreeSet<usize>> = vec![Default::default(); hi - lo];
         for e in self.elements.iter().filter(|e| e.mine) {
-            let dofs: Vec<i32> = e.dofs().chain(self.multiplier_reach(e)).collect();
+            let dofs: Vec<i32> = e.dofs().collect();
             for r in e.dofs() {
                 let Some(l) = self.own_row(r) else { continue };
                 cols[l].insert(np);
@@ -507,12 +507,6 @@ impl<'a> CondensedSystem<'a> {
         (d, o)
     }
 
-    /// The pressure unknowns of the triangles around an element's nodes: the reach of its
-    /// rows' Jacobian with the cavitation multiplier (none without it).
-    fn multiplier_reach<'s>(&'s self, e: &'s Element) -> impl Iterator<Item = i32> + 's {
-        self.multipliers.iter().flat_map(move |m| e.ids.iter().flat_map(move |&k| m.around(k))).flat_map(move |&t| self.elements[t].dofs())
-    }
-
     /// The Jacobian with rigid solids (H = H0 + gap): sparse, element by element.
     fn jacobian_rigid(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
         let np = self.layout.n_p;
@@ -521,21 +515,11 @@ impl<'a> CondensedSystem<'a> {
         self.measure_multipliers(x, &h);
         let fluid = self.fluid();
         let slopes = self.complementarity_slopes(x, &h);
-        let pattern = !j.is_assembled()?;
         j.zero()?;
         for e in self.elements.iter().filter(|e| e.mine) {
             let p = Self::element_p(x, e);
             let he = e.face.map(|f| h[f]);
             let out = self.eval(e, &p, &he, &fluid);
-            if pattern && self.multipliers.is_some() {
-                // The multiplier's whole reach, as zeros in the first fill: the pattern is
-                // fixed at the first assembly, and the cavitated set moves afterwards.
-                let reach: Vec<i32> = self.multiplier_reach(e).collect();
-                let zeros = vec![0.0; reach.len()];
-                for r in e.dofs().filter(|&r| self.own_row(r).is_some()) {
-                    j.add_values(&[r], &reach, &zeros)?;
-                }
-            }
             let mut err = Ok(());
             self.chain_multiplier(x, &h, e, &out.dr_dm, &fluid, |d, f, dp, dh| {
                 if self.own_row(d).is_none() || err.is_err() {
@@ -765,6 +749,14 @@ impl Problem for CondensedSystem<'_> {
         let ncl = fb.cols.len();
         let mut buf = vec![0.0; fb.rows.len() * ncl];
         let h0_col = fb.col_of(np as i32);
+        // dR/dH per (row, face node), summed over the elements (and the multiplier's chain)
+        // before each face node's compliance row is subtracted once: a vertex row meets its
+        // face nodes from about six elements, and the dense row updates are the cost here.
+        let mut dr_dh: Vec<Vec<(usize, f64)>> = vec![Vec::new(); fb.rows.len()];
+        let mut add_dh = |l: usize, f: usize, g: f64| match dr_dh[l].iter_mut().find(|(k, _)| *k == f) {
+            Some((_, v)) => *v += g,
+            None => dr_dh[l].push((f, g)),
+        };
         for e in &self.elements {
             if !e.any_dof(|d| fb.row_of(d).is_some()) {
                 continue;
@@ -781,9 +773,7 @@ impl Problem for CondensedSystem<'_> {
                     }
                 }
                 if dh != 0.0 {
-                    for (a, c) in row.iter_mut().zip(fb.c_row(self.comp, f)) {
-                        *a -= dh * c;
-                    }
+                    add_dh(l, f, dh);
                     if let Some(c) = h0_col {
                         row[c] += dh;
                     }
@@ -802,15 +792,19 @@ impl Problem for CondensedSystem<'_> {
                     // H = H0 + gap - U_y with U_y = C P: dH/dP = -C, dH/dH0 = 1.
                     let g = pr.dh[a][k];
                     if g != 0.0 {
-                        if !self.comp.is_rigid() {
-                            for (a, c) in row.iter_mut().zip(fb.c_row(self.comp, e.face[k])) {
-                                *a -= g * c;
-                            }
-                        }
+                        add_dh(l, e.face[k], g);
                         if let Some(c) = h0_col {
                             row[c] += g;
                         }
                     }
+                }
+            }
+        }
+        for (l, terms) in dr_dh.iter().enumerate() {
+            let row = &mut buf[l * ncl..(l + 1) * ncl];
+            for &(f, g) in terms {
+                for (a, c) in row.iter_mut().zip(fb.c_row(self.comp, f)) {
+                    *a -= g * c;
                 }
             }
         }

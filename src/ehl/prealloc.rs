@@ -6,14 +6,10 @@ use crate::mesh::{Mesh, Partition};
 use crate::solid::dofmap::owned_node_neighbours;
 use std::collections::HashMap;
 
-/// Contact-face neighbours of each contact node: nodes sharing a contact triangle (with
-/// the cavitation multiplier, `two_rings`, the nodes of the triangles around those), and
+/// Contact-face neighbours of each contact node: nodes sharing a contact triangle, and
 /// with the gradient-jump term (`jumps`) the nodes of the triangles across each edge.
-pub fn contact_neighbours(mesh: &Mesh, jumps: bool, two_rings: bool) -> HashMap<u32, Vec<u32>> {
+pub fn contact_neighbours(mesh: &Mesh, jumps: bool) -> HashMap<u32, Vec<u32>> {
     let mut nb: HashMap<u32, Vec<u32>> = HashMap::new();
-    if two_rings {
-        nb = crate::reynolds::multiplier::two_rings(&mesh.contact_tris);
-    }
     for tri in &mesh.contact_tris {
         for &a in tri {
             nb.entry(a).or_default().extend_from_slice(tri);
@@ -37,14 +33,12 @@ pub fn contact_neighbours(mesh: &Mesh, jumps: bool, two_rings: bool) -> HashMap<
     nb
 }
 
-/// (d_nnz, o_nnz) for the rows this rank owns (`two_rings`: the Reynolds rows reach the
-/// cavitation multiplier's stencil, see [`contact_neighbours`]).
-pub fn preallocation(mesh: &Mesh, part: &Partition, layout: &Layout, rank: usize, jumps: bool, two_rings: bool) -> (Vec<i32>, Vec<i32>) {
+/// (d_nnz, o_nnz) for the rows this rank owns.
+pub fn preallocation(mesh: &Mesh, part: &Partition, layout: &Layout, rank: usize, jumps: bool) -> (Vec<i32>, Vec<i32>) {
     let (lo, hi) = (layout.ranges[rank] as i32, layout.ranges[rank + 1] as i32);
     let n = (hi - lo) as usize;
     let (mut d_nnz, mut o_nnz) = (vec![0i32; n], vec![0i32; n]);
-    let contact = contact_neighbours(mesh, jumps, false);
-    let reynolds = if two_rings { contact_neighbours(mesh, jumps, true) } else { contact.clone() };
+    let contact = contact_neighbours(mesh, jumps);
     let mut count = |row: i32, cols: &[i32]| {
         if row < lo || row >= hi {
             return;
@@ -82,7 +76,7 @@ pub fn preallocation(mesh: &Mesh, part: &Partition, layout: &Layout, rank: usize
             }
             count(row, &cols);
         }
-        if let Some(cn) = reynolds.get(&node) {
+        if let Some(cn) = contact.get(&node) {
             let row = layout.p[node as usize];
             if row >= 0 {
                 cols.clear();

@@ -613,7 +613,6 @@ impl Problem for EhlSystem<'_> {
 
     fn jacobian(&mut self, x: &[f64], j: &Matrix) -> Result<()> {
         self.jacobian_evals += 1;
-        let first = !j.is_assembled()?;
         if !self.jacobian_built {
             j.zero()?;
             self.add_stiffness(j)?;
@@ -636,15 +635,6 @@ impl Problem for EhlSystem<'_> {
             let out = self.reynolds(x, e, &fluid);
             let rows_p: [i32; 6] = e.nodes.map(|n| self.layout.p[n as usize]);
             if let Some((all, m)) = &self.face {
-                // The multiplier's reach (two rings): explicit zeros in the first Jacobian
-                // keep the pattern, since the cavitated set moves between iterations.
-                if first {
-                    for t in e.nodes.iter().flat_map(|k| m.around(*k)) {
-                        let cols: Vec<i32> =
-                            all[*t].nodes.iter().flat_map(|&n| [self.layout.p[n as usize], self.layout.u[n as usize][1]]).collect();
-                        j.add_values(&rows_p, &cols, &vec![0.0; 6 * cols.len()])?;
-                    }
-                }
                 let sc: [f64; 6] = rows_p.map(|r| self.scale_of(r));
                 let mut err = Ok(());
                 m.chain(

@@ -125,14 +125,6 @@ impl Matrix {
         pcall!(ffi::MatAssemblyEnd(self.raw, ffi::MatAssemblyType_MAT_FINAL_ASSEMBLY))
     }
 
-    /// Whether the matrix has been assembled (its nonzero pattern is fixed from then on:
-    /// unused preallocation is dropped at the first assembly).
-    pub fn is_assembled(&self) -> Result<bool> {
-        let mut b = ffi::PetscBool_PETSC_FALSE;
-        pcall!(ffi::MatAssembled(self.raw, &mut b))?;
-        Ok(b == ffi::PetscBool_PETSC_TRUE)
-    }
-
     /// Sets all stored entries to zero, keeping the pattern.
     pub fn zero(&self) -> Result<()> {
         pcall!(ffi::MatZeroEntries(self.raw))

@@ -9,9 +9,12 @@
 //! residual (the Reynolds row without SUPG) over its lumped area, and the element weighs
 //! it by 1 - pressurised(P_k) ([`super::element::reynolds_element_with_multiplier`]).
 //!
-//! g_k depends on the unknowns of every triangle around k, so a row's Jacobian reaches the
-//! triangles around its element's nodes (two rings). [`Multipliers::chain`] gives those
-//! entries node by node; each coupling maps them to its own columns.
+//! g_k depends on the unknowns of every triangle around k, so a row's exact Jacobian
+//! reaches the triangles around its element's nodes (two rings). [`Multipliers::chain`]
+//! gives the entries that fall inside the Reynolds rows' own pattern (the nodes sharing a
+//! triangle with the row's node) and drops those beyond: the two-ring pattern made each LU
+//! a third dearer, and Newton took as many iterations without it (docs/numerics.md,
+//! "Cavitation as complementarity"). Each coupling maps the entries to its own columns.
 
 use super::element::{reynolds_element, ElementOut, Fluid, Stabilisation};
 use std::collections::HashMap;
@@ -38,6 +41,9 @@ pub struct Multipliers {
     area: HashMap<u32, f64>,
     /// The triangles around each contact node.
     around: HashMap<u32, Vec<usize>>,
+    /// The nodes sharing a triangle with each contact node (sorted): a Reynolds row's
+    /// pattern.
+    ring: HashMap<u32, Vec<u32>>,
     /// g_k at the last [`Multipliers::evaluate`].
     value: HashMap<u32, f64>,
 }
@@ -47,6 +53,7 @@ impl Multipliers {
     pub fn new(tris: &[[u32; 6]], areas: &[f64]) -> Self {
         let mut area: HashMap<u32, f64> = HashMap::new();
         let mut around: HashMap<u32, Vec<usize>> = HashMap::new();
+        let mut ring: HashMap<u32, Vec<u32>> = HashMap::new();
         for (t, (tri, a)) in tris.iter().zip(areas).enumerate() {
             for &n in tri {
                 *area.entry(n).or_insert(0.0) += a / 6.0;
@@ -54,9 +61,14 @@ impl Multipliers {
                 if list.last() != Some(&t) {
                     list.push(t);
                 }
+                ring.entry(n).or_default().extend_from_slice(tri);
             }
         }
-        Multipliers { area, around, value: HashMap::new() }
+        for v in ring.values_mut() {
+            v.sort_unstable();
+            v.dedup();
+        }
+        Multipliers { area, around, ring, value: HashMap::new() }
     }
 
     /// g_k at every contact node from the Galerkin residuals of all `n` triangles
@@ -74,11 +86,6 @@ impl Multipliers {
         self.value = sum.into_iter().map(|(node, g)| (node, g / self.area[&node])).collect();
     }
 
-    /// The triangles around a contact node.
-    pub fn around(&self, node: u32) -> &[usize] {
-        self.around.get(&node).map_or(&[], |v| v.as_slice())
-    }
-
     /// g at the nodes of one triangle (0 at a node never evaluated).
     pub fn of(&self, nodes: &[u32; 6]) -> [f64; 6] {
         nodes.map(|n| self.value.get(&n).copied().unwrap_or(0.0))
@@ -86,7 +93,9 @@ impl Multipliers {
 
     /// The multiplier's part of a row element's Jacobian: with `dr_dm` = dR_i/dg_k of the
     /// element on `nodes`, calls `add(i, node, dR_i/dP_node, dR_i/dH_node)` for every node
-    /// of the triangles around each k that the element's rows depend on.
+    /// of the triangles around each k that row i depends on and that shares a triangle with
+    /// row i's node (the row's pattern; the module documentation says why the rest is
+    /// dropped). Summed over every element, the entries inside that pattern are exact.
     pub fn chain<'a>(
         &self,
         nodes: &[u32; 6],
@@ -120,34 +129,14 @@ impl Multipliers {
                     if c == 0.0 {
                         continue;
                     }
+                    let ring = &self.ring[&nodes[i]];
                     for (m, &col) in e.nodes.iter().enumerate() {
-                        add(i, col, c * out.dr_dp[row][m], c * out.dr_dh[row][m]);
+                        if ring.binary_search(&col).is_ok() {
+                            add(i, col, c * out.dr_dp[row][m], c * out.dr_dh[row][m]);
+                        }
                     }
                 }
             }
         }
     }
-}
-
-/// Every contact node's two-ring: the nodes of the triangles around the nodes of the
-/// triangles around it (the reach of a row's Jacobian with the multiplier).
-pub fn two_rings(tris: &[[u32; 6]]) -> HashMap<u32, Vec<u32>> {
-    let mut one: HashMap<u32, Vec<u32>> = HashMap::new();
-    for tri in tris {
-        for &a in tri {
-            one.entry(a).or_default().extend_from_slice(tri);
-        }
-    }
-    for v in one.values_mut() {
-        v.sort_unstable();
-        v.dedup();
-    }
-    one.iter()
-        .map(|(&a, nb)| {
-            let mut two: Vec<u32> = nb.iter().flat_map(|b| one[b].iter().copied()).collect();
-            two.sort_unstable();
-            two.dedup();
-            (a, two)
-        })
-        .collect()
 }

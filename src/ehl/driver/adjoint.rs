@@ -144,8 +144,7 @@ impl EhlSolver<'_> {
             }
         }
         let k = assembly::assemble_stiffness(comm, mesh, self.part, self.dofs, ctx.rank, eq.nu)?;
-        let (d_nnz, o_nnz) =
-            preallocation(mesh, self.part, layout, ctx.rank, params.stabilisation.jump > 0.0, params.stabilisation.complementarity);
+        let (d_nnz, o_nnz) = preallocation(mesh, self.part, layout, ctx.rank, params.stabilisation.jump > 0.0);
         let j = Matrix::new_aij(comm, local, &d_nnz, &o_nnz)?;
         let mut system = EhlSystem::new(&ctx.world, mesh, self.part, self.dofs, layout, ctx.rank, params, lubricant(scene), k)?;
         system.jacobian(x, &j)?;

@@ -484,7 +484,7 @@ fn solve_monolithic<'a>(
     };
     let label = start.label();
     let params = ehl_params(scene, eq.nu, half);
-    let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank, params.stabilisation.jump > 0.0, params.stabilisation.complementarity);
+    let (d_nnz, o_nnz) = preallocation(mesh, part, layout, ctx.rank, params.stabilisation.jump > 0.0);
     let j = Matrix::new_aij(comm, layout.local(ctx.rank), &d_nnz, &o_nnz)?;
     let mut system = EhlSystem::new(&ctx.world, mesh, part, dofs, layout, ctx.rank, params, lubricant(scene), k)?;
     let assembly_s = t0.elapsed().as_secs_f64();
