@@ -749,9 +749,10 @@ impl Problem for CondensedSystem<'_> {
         let ncl = fb.cols.len();
         let mut buf = vec![0.0; fb.rows.len() * ncl];
         let h0_col = fb.col_of(np as i32);
-        // dR/dH per (row, face node), summed over the elements (and the multiplier's chain)
-        // before each face node's compliance row is subtracted once: a vertex row meets its
-        // face nodes from about six elements, and the dense row updates are the cost here.
+        // dR/dH per (row, face node), summed over the elements and the multiplier's chain
+        // before each face node's compliance row is subtracted once: each subtraction is a
+        // dense row update, and the chain reaches the same face nodes from several
+        // cavitated nodes (docs/numerics.md, "Cavitation as complementarity").
         let mut dr_dh: Vec<Vec<(usize, f64)>> = vec![Vec::new(); fb.rows.len()];
         let mut add_dh = |l: usize, f: usize, g: f64| match dr_dh[l].iter_mut().find(|(k, _)| *k == f) {
             Some((_, v)) => *v += g,
