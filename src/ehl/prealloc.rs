@@ -9,12 +9,7 @@ use std::collections::HashMap;
 /// Contact-face neighbours of each contact node: nodes sharing a contact triangle, and
 /// with the gradient-jump term (`jumps`) the nodes of the triangles across each edge.
 pub fn contact_neighbours(mesh: &Mesh, jumps: bool) -> HashMap<u32, Vec<u32>> {
-    let mut nb: HashMap<u32, Vec<u32>> = HashMap::new();
-    for tri in &mesh.contact_tris {
-        for &a in tri {
-            nb.entry(a).or_default().extend_from_slice(tri);
-        }
-    }
+    let mut nb = crate::fem::p2tri::node_rings(&mesh.contact_tris);
     if jumps {
         for (a, b, _) in crate::reynolds::jump::interior_edges(&mesh.contact_tris) {
             let (ta, tb) = (mesh.contact_tris[a], mesh.contact_tris[b]);
@@ -25,10 +20,10 @@ pub fn contact_neighbours(mesh: &Mesh, jumps: bool) -> HashMap<u32, Vec<u32>> {
                 nb.entry(n).or_default().extend_from_slice(&ta);
             }
         }
-    }
-    for v in nb.values_mut() {
-        v.sort_unstable();
-        v.dedup();
+        for v in nb.values_mut() {
+            v.sort_unstable();
+            v.dedup();
+        }
     }
     nb
 }

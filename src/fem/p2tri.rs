@@ -121,6 +121,22 @@ pub fn p2_tri_weights(area: f64) -> [f64; 6] {
     [0.0, 0.0, 0.0, area / 3.0, area / 3.0, area / 3.0]
 }
 
+/// The nodes sharing a triangle with each node of the P2 triangles `tris` (the node itself
+/// included; sorted): the stencil of a row assembled from those triangles.
+pub fn node_rings(tris: &[[u32; 6]]) -> std::collections::HashMap<u32, Vec<u32>> {
+    let mut ring: std::collections::HashMap<u32, Vec<u32>> = std::collections::HashMap::new();
+    for tri in tris {
+        for &n in tri {
+            ring.entry(n).or_default().extend_from_slice(tri);
+        }
+    }
+    for v in ring.values_mut() {
+        v.sort_unstable();
+        v.dedup();
+    }
+    ring
+}
+
 /// A straight P2 triangle in physical coordinates, with what the Reynolds element needs:
 ///
 /// Local node order: v0, v1, v2, mid(0,1), mid(1,2), mid(2,0). With barycentric

@@ -53,7 +53,6 @@ impl Multipliers {
     pub fn new(tris: &[[u32; 6]], areas: &[f64]) -> Self {
         let mut area: HashMap<u32, f64> = HashMap::new();
         let mut around: HashMap<u32, Vec<usize>> = HashMap::new();
-        let mut ring: HashMap<u32, Vec<u32>> = HashMap::new();
         for (t, (tri, a)) in tris.iter().zip(areas).enumerate() {
             for &n in tri {
                 *area.entry(n).or_insert(0.0) += a / 6.0;
@@ -61,14 +60,9 @@ impl Multipliers {
                 if list.last() != Some(&t) {
                     list.push(t);
                 }
-                ring.entry(n).or_default().extend_from_slice(tri);
             }
         }
-        for v in ring.values_mut() {
-            v.sort_unstable();
-            v.dedup();
-        }
-        Multipliers { area, around, ring, value: HashMap::new() }
+        Multipliers { area, around, ring: crate::fem::p2tri::node_rings(tris), value: HashMap::new() }
     }
 
     /// g_k at every contact node from the Galerkin residuals of all `n` triangles
