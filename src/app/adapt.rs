@@ -30,6 +30,11 @@
 //!    triangle at the smallest size), the
 //!    last level's result is written with its estimated error, `accuracy.reached` is
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
+//! 7. A level whose cavitation penalty's own error stands between it and the target
+//!    (`estimate::penalty_in_the_way`) has its mesh solved again as complementarity, as the
+//!    next level, and the levels after it solve complementarity too. In the estimate's
+//!    sequence that level takes the penalty level's place, the coarser levels counted less
+//!    the penalty's error it measured (`estimate::sequence`).
 use super::estimate::{penalty_in_the_way, Estimate, PenaltyError, PenaltySlopes, SHORT_PENALTY_SHARE};
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, PointResult, Setup};
@@ -89,6 +94,12 @@ pub struct Level {
     /// The cavitation penalty the level was solved at and its estimated error (where the
     /// penalty was staged, [`super::estimate::PenaltyError`]).
     pub penalty: Option<PenaltyError>,
+    /// The level is the mesh of the level before it solved again, as complementarity: the
+    /// cavitation penalty's own error stood in the way there
+    /// ([`super::estimate::penalty_in_the_way`]). In the estimate's sequence it takes that
+    /// level's place, and the levels before it count less the penalty's error this one
+    /// measured (`estimate::sequences`).
+    pub again: bool,
 }
 
 impl Level {
@@ -211,6 +222,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     // The present level was made by quartering and its plain Newton failed: it is meshed
     // again with the quartered triangles halved.
     let mut halve_quartered = false;
+    // The present level is the mesh of the level before solved again as complementarity
+    // (the cavitation penalty's own error stood in the way there).
+    let mut again = false;
     loop {
         let scene = &own;
         if std::mem::take(&mut halve_quartered) {
@@ -237,7 +251,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // anyway, and halving leaves room for the rest of the marking
         // (cases/hard/spin-0.5deg: quartered, level 4 would have had 998,894 unknowns).
         // The marking then halves, here and in a cut below.
-        if let Some(prev) = previous.as_mut().filter(|p| n > budget && p.marking.as_ref().is_some_and(|m| m.quartered() > 0)) {
+        // A level solved again on its own mesh was within its budget.
+        let over_budget = n > budget && !again;
+        if let Some(prev) = previous.as_mut().filter(|p| over_budget && p.marking.as_ref().is_some_and(|m| m.quartered() > 0)) {
             ctx.log(format!(
                 "accuracy: level {k} would have {n} unknowns, above its budget of {budget}; again with its {} quartered triangles halved",
                 prev.marking.as_ref().map_or(0, |m| m.quartered())
@@ -245,7 +261,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             next = prev.halved_marking(growth);
             continue;
         }
-        if let (Some(prev), true) = (&previous, n > budget) {
+        if let (Some(prev), true) = (&previous, over_budget) {
             // The level is cut to the budget: the marked triangles of largest indicator that
             // fit, once per run (a cut level is the last, below), and not when even the next
             // full level's change could not take every estimate below the target.
@@ -311,6 +327,35 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // A staged penalty that stalls short of the scene's is judged by its error here.
         solver.accept_short_penalty(true);
         let sol = match (&previous, earlier) {
+            // The penalty level's mesh as complementarity, from its solution. Where that does
+            // not converge, the penalty level stays and the levels after it solve
+            // complementarity from its pressure.
+            (Some(prev), _) if again => match collective::agree(&ctx.world, solve_again(ctx, scene, &solver, prev, k - 1)) {
+                Ok(sol) => sol,
+                Err(e) if crate::interrupt::agreed() == 0 && newton_failed(ctx, &e) => {
+                    drop(solver);
+                    again = false;
+                    let why =
+                        format!("level {} did not converge as complementarity from its solution with the penalty ({})", k - 1, reason(&e));
+                    match prev.marking.as_ref() {
+                        Some(m) => {
+                            ctx.log(format!("accuracy: {why}; the levels after it solve complementarity from its pressure"));
+                            next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), m, None, growth));
+                            tried_s += t0.elapsed().as_secs_f64();
+                            continue;
+                        }
+                        // The penalty level was the last one the budget allows.
+                        None => {
+                            let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
+                            return finish(ctx, scene, prev, target, &levels, Some(why));
+                        }
+                    }
+                }
+                Err(e) => {
+                    drop(solver);
+                    return out_of_time(ctx, scene, Some(prev), k, &levels, e);
+                }
+            },
             (Some(prev), _) => {
                 let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
                 let p = |x: f64, z: f64| pf.at(x, z).map_or(0.0, |v| v.0);
@@ -546,6 +591,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let min_size = edges.iter().cloned().fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
         // The pass's adapted rule is kept for the friction goals' gradient below.
         let friction = level_friction(ctx, scene, &fields)?;
+        // A level solved again takes the place of the one before it: its cut and halvings.
+        let replaced = levels.last().filter(|_| again);
         let level = Level {
             elastic_unknowns: n_u,
             pressure_unknowns: n_p,
@@ -560,10 +607,15 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             pmax: st.pmax * ph,
             friction: friction.as_ref().map(|f| [f.fx, f.fz]),
             est: None,
-            cut: cut.take(),
-            halvings: if k == 0 { 1 } else { next.as_ref().map_or(1, |m| m.halvings) },
+            cut: replaced.map_or_else(|| cut.take(), |l| l.cut),
+            halvings: match replaced {
+                Some(l) => l.halvings,
+                None if k == 0 => 1,
+                None => next.as_ref().map_or(1, |m| m.halvings),
+            },
             // Set below, once the slopes are known.
             penalty: None,
+            again: std::mem::take(&mut again),
         };
         over.clear();
         levels.push(level);
@@ -574,7 +626,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // A level cut to the budget is the last: the level after it would refine the rest of
         // its marking and more, over the budget, and would not be cut again.
         let cut_level = levels.last().is_some_and(|l| l.cut.is_some());
-        let may_go_on = k < max_levels && !cut_level;
+        // Refinements so far: a level solved again on its mesh is none.
+        let refined = k - levels.iter().filter(|l| l.again).count();
+        let may_go_on = refined < max_levels && !cut_level;
         // One adjoint LU serves the next level's marking, the speed exponents when asked for,
         // and the values' slopes in the cavitation penalty, which estimate the penalty's own
         // error: on every level that has an estimate (the second on), also the last, and on
@@ -605,7 +659,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let level = levels.last_mut().expect("the level just pushed");
         level.est = est;
         ctx.log(format!(
-            "accuracy: level {k}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}{}; estimated error {}",
+            "accuracy: level {k}{}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}{}; estimated error {}",
+            if level.again { format!(" (level {}'s mesh as complementarity)", k - 1) } else { String::new() },
             level.contact_triangles,
             level.min_size,
             level.cut.map_or(String::new(), |c| format!(
@@ -626,7 +681,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             level.penalty.filter(|p| p.short()).map_or(String::new(), |p| format!(" (cavitation penalty xi = {:.3e}, short of the scene's {:e})", p.xi, p.scene_xi)),
             level.est.map_or("- (first level)".to_string(), |e| e.describe())
         ));
-        let reached = k >= 2 && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
+        let reached = refined >= 2 && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
         let last = reached || !may_go_on;
         let exponents = match (&mut adjoint, scene.output.speed_exponents) {
             (Some(Ok(a)), true) => Some(collective::agree(&ctx.world, super::sensitivity::speed_exponents(ctx, a, &fields, &st))),
@@ -675,7 +730,29 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             ctx.log(format!("accuracy: target {target} reached at level {k}"));
             return finish(ctx, scene, &here, target, &levels, None);
         }
-        if k == max_levels {
+        // The mesh's refinement cannot take the penalty's own error below the target: a
+        // penalty part above a quarter of it, once the mesh's part is below it, has this
+        // level's mesh solved again, and the levels after it solved, with the Reynolds
+        // condition as complementarity, which has no such part. In the estimate the level
+        // solved again takes this one's place (docs/accuracy.md, "Complementarity where it
+        // dominates").
+        let in_the_way = levels.last().and_then(|l| l.penalty.filter(|p| penalty_in_the_way(p, l.est.as_ref(), target)));
+        if let Some(p) = in_the_way.filter(|_| own.effects.cavitation == CavitationModel::Penalty) {
+            ctx.log(format!(
+                "accuracy: the cavitation penalty's part of the estimate (hc {:.3} %, hm {:.3} %{}) is above a quarter of the target, the mesh's part below it; level {k}'s mesh is solved again, and the levels after it solved, with cavitation as complementarity (effects.cavitation = \"complementarity\"), which has no such part",
+                100.0 * p.hc,
+                100.0 * p.hm,
+                p.friction.map_or(String::new(), |[fx, fz]| format!(", fx {:.3} %, fz {:.3} %", 100.0 * fx, 100.0 * fz)),
+            ));
+            if let Err(e) = crate::interrupt::check("adaptive refinement") {
+                return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
+            }
+            own.effects.cavitation = CavitationModel::Complementarity;
+            again = true;
+            previous = Some(here);
+            continue;
+        }
+        if refined >= max_levels {
             let why = short_of(target, &format!("accuracy.max_levels = {max_levels} refinement levels solved"), k, est);
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
@@ -700,22 +777,34 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
             return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
         }
-        // The mesh's refinement cannot take the penalty's own error below the target: a
-        // penalty part above a quarter of it, once the mesh's part is below it, has the
-        // levels after solve the Reynolds condition as complementarity, which has no such
-        // part (docs/accuracy.md, "The cavitation penalty's own error").
-        let in_the_way = levels.last().and_then(|l| l.penalty.filter(|p| penalty_in_the_way(p, l.est.as_ref(), target)));
-        if let Some(p) = in_the_way.filter(|_| own.effects.cavitation == CavitationModel::Penalty) {
-            ctx.log(format!(
-                "accuracy: the cavitation penalty's part of the estimate (hc {:.3} %, hm {:.3} %{}) is above a quarter of the target, the mesh's part below it; the levels after level {k} solve cavitation as complementarity (effects.cavitation = \"complementarity\"), which has no such part",
-                100.0 * p.hc,
-                100.0 * p.hm,
-                p.friction.map_or(String::new(), |[fx, fz]| format!(", fx {:.3} %, fz {:.3} %", 100.0 * fx, 100.0 * fz)),
-            ));
-            own.effects.cavitation = CavitationModel::Complementarity;
-        }
         previous = Some(here);
     }
+}
+
+/// Level `k`'s mesh solved again as complementarity (`scene`) from its solution with the
+/// cavitation penalty, `prev`: plain Newton from the pressure and, after a monolithic
+/// level, the displacement. The two differ by the penalty's error alone, a few tenths of a
+/// per cent of the film, so no continuation is offered. Collective.
+fn solve_again<'a>(ctx: &'a Context, scene: &Scene, solver: &EhlSolver<'a>, prev: &Solved, k: usize) -> Result<EhlSolution, Error> {
+    let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
+    let p = |x: f64, z: f64| pf.at(x, z).map_or(0.0, |v| v.0);
+    let label = format!("level {k}'s solution with the cavitation penalty");
+    let coarser = (prev.sol.coupling == Coupling::Monolithic).then_some(Coarser {
+        mesh: &prev.setup.mesh,
+        layout: &prev.setup.layout,
+        x: &prev.sol.x,
+    });
+    let start = Start::Pressure {
+        p: &p,
+        hc: prev.hc,
+        label: &label,
+        tries: Tries::Plain,
+        milder: None,
+        last_resorts: false,
+        ramp: RampLimits::DEFAULT,
+        coarser,
+    };
+    solver.solve_from(ctx, scene, start)
 }
 
 /// Whether `e` is Newton's own failure, the same on every rank (not one rank's local
@@ -915,6 +1004,10 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
             }
             if let Some(p) = l.penalty {
                 v["penalty"] = p.json();
+            }
+            // The mesh of the level before, solved again as complementarity.
+            if l.again {
+                v["complementarity_on_the_mesh_of_level"] = json!(k - 1);
             }
             v
         }).collect::<Vec<_>>(),
