@@ -634,7 +634,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // error: on every level that has an estimate (the second on), also the last, and on
         // the first when it marks anyway.
         let slopes_wanted = k >= 1 && penalised;
-        let goal = may_go_on && acc.marking > 0.0;
+        // Without the penalty the estimate needs no slopes: a level it already takes below
+        // the target is the last, and its marking is not needed.
+        let settled = !penalised && refined >= 2 && Estimate::of(&levels).is_some_and(|e| e.values().iter().all(|&v| v < target));
+        let goal = may_go_on && acc.marking > 0.0 && !settled;
         let mut adjoint = (goal || slopes_wanted || scene.output.speed_exponents)
             .then(|| collective::agree(&ctx.world, solver.adjoint(ctx, scene, &sol.x)));
         let goals_of = match &adjoint {
