@@ -31,8 +31,9 @@
 //!    last level's result is written with its estimated error, `accuracy.reached` is
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
 //! 7. A level whose cavitation penalty's own error stands between it and the target
-//!    (`estimate::penalty_in_the_way`) has its mesh solved again as complementarity, as the
-//!    next level, and the levels after it solve complementarity too. In the estimate's
+//!    (`estimate::penalty_in_the_way`), or alone keeps a level cut to the budget from it,
+//!    has its mesh solved again as complementarity, as the next level, and the levels after
+//!    it solve complementarity too. In the estimate's
 //!    sequence that level takes the penalty level's place, the coarser levels counted less
 //!    the penalty's error it measured (`estimate::sequence`).
 use super::estimate::{penalty_in_the_way, Estimate, PenaltyError, PenaltySlopes, SHORT_PENALTY_SHARE};
@@ -153,6 +154,9 @@ struct Solved {
     cavitation: CavitationModel,
     /// The marking of the next level (None on the last).
     marking: Option<Marking>,
+    /// The size field the level was meshed with (None: the scene's mesh), for solving its
+    /// mesh again.
+    mesh_from: Option<NextMesh>,
     /// The level's friction pass, which the result's post-processing reports (a second
     /// pass on the same state gives the same numbers: on a 0.0078 a level of a thick film
     /// it took 66 s).
@@ -281,6 +285,24 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             let ranked = prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| over.len() < MAX_CUTS);
             let hopeful =
                 ranked.is_some() && Estimate::cut_could_reach(&levels, target, scene.effects.cavitation == CavitationModel::Penalty);
+            // A cut level kept from the target by the cavitation penalty's part alone: the
+            // level before is solved again as complementarity, and the cut is gated and
+            // estimated on that sequence (below, step 7 of the module documentation).
+            let penalty_alone = ranked.is_some()
+                && !hopeful
+                && scene.effects.cavitation == CavitationModel::Penalty
+                && levels.last().is_some_and(|l| l.penalty.is_some())
+                && Estimate::cut_could_reach(&levels, target, false);
+            if penalty_alone {
+                ctx.log(format!(
+                    "accuracy: {over_what}, and the cavitation penalty's part alone keeps a level cut to it from the target; level {}'s mesh is solved again, and the levels after it solved, with cavitation as complementarity (effects.cavitation = \"complementarity\"), which has no such part",
+                    k - 1
+                ));
+                next = prev.mesh_from.clone();
+                own.effects.cavitation = CavitationModel::Complementarity;
+                again = true;
+                continue;
+            }
             if let Some((m, marked)) = ranked.filter(|_| hopeful) {
                 over.push((cut.map_or(marked, |c| c.count), n));
                 let count = cut_count(before, &over, budget);
@@ -727,6 +749,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             gradient_jump: scene.reynolds.gradient_jump,
             cavitation: scene.effects.cavitation,
             marking: marked,
+            mesh_from: next.clone(),
             friction,
         };
         if reached {

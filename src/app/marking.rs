@@ -458,6 +458,7 @@ impl Marking {
 /// The next level's mesh: its size field and the halvings its finest refinement makes
 /// ([`super::adapt::Level`]'s `halvings`, for the estimate's crossing guard), kept in one
 /// value so that every way of making the field says how far it refines.
+#[derive(Clone)]
 pub(super) struct NextMesh {
     pub field: Arc<SizeField>,
     pub halvings: u32,
