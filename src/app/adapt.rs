@@ -294,12 +294,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 && levels.last().is_some_and(|l| l.penalty.is_some())
                 && Estimate::cut_could_reach(&levels, target, false);
             if penalty_alone {
-                ctx.log(format!(
-                    "accuracy: {over_what}, and the cavitation penalty's part alone keeps a level cut to it from the target; level {}'s mesh is solved again, and the levels after it solved, with cavitation as complementarity (effects.cavitation = \"complementarity\"), which has no such part",
-                    k - 1
-                ));
+                let why = format!("{over_what}, and the cavitation penalty's part alone keeps a level cut to it from the target");
+                to_complementarity(ctx, &mut own, k - 1, &why);
                 next = prev.mesh_from.clone();
-                own.effects.cavitation = CavitationModel::Complementarity;
                 again = true;
                 continue;
             }
@@ -764,16 +761,17 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // dominates").
         let in_the_way = levels.last().and_then(|l| l.penalty.filter(|p| penalty_in_the_way(p, l.est.as_ref(), target)));
         if let Some(p) = in_the_way.filter(|_| own.effects.cavitation == CavitationModel::Penalty) {
-            ctx.log(format!(
-                "accuracy: the cavitation penalty's part of the estimate (hc {:.3} %, hm {:.3} %{}) is above a quarter of the target, the mesh's part below it; level {k}'s mesh is solved again, and the levels after it solved, with cavitation as complementarity (effects.cavitation = \"complementarity\"), which has no such part",
-                100.0 * p.hc,
-                100.0 * p.hm,
-                p.friction.map_or(String::new(), |[fx, fz]| format!(", fx {:.3} %, fz {:.3} %", 100.0 * fx, 100.0 * fz)),
-            ));
             if let Err(e) = crate::interrupt::check("adaptive refinement") {
                 return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
             }
-            own.effects.cavitation = CavitationModel::Complementarity;
+            let why = format!(
+                "the cavitation penalty's part of the estimate (hc {:.3} %, hm {:.3} %{}) is above a quarter of the target, the mesh's part below it",
+                100.0 * p.hc,
+                100.0 * p.hm,
+                p.friction.map_or(String::new(), |[fx, fz]| format!(", fx {:.3} %, fz {:.3} %", 100.0 * fx, 100.0 * fz)),
+            );
+            to_complementarity(ctx, &mut own, k, &why);
+            next = here.mesh_from.clone();
             again = true;
             previous = Some(here);
             continue;
@@ -805,6 +803,16 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         }
         previous = Some(here);
     }
+}
+
+/// Switches the scene being solved, `own`, to cavitation as complementarity because of
+/// `why`: level `k`'s mesh is solved again as the next level (its size field is the
+/// caller's to restore), and the levels after it are solved so too.
+fn to_complementarity(ctx: &Context, own: &mut Scene, k: usize, why: &str) {
+    ctx.log(format!(
+        "accuracy: {why}; level {k}'s mesh is solved again, and the levels after it solved, with cavitation as complementarity (effects.cavitation = \"complementarity\"), which has no such part"
+    ));
+    own.effects.cavitation = CavitationModel::Complementarity;
 }
 
 /// Level `k`'s mesh solved again as complementarity (`scene`) from its solution with the

@@ -666,8 +666,7 @@ mod tests {
         let e = Estimate::of(&levels).unwrap();
         // The sequence of complementarity levels that never had a penalty gives the same
         // estimate, but for the penalty's change over the mesh (none here).
-        let clean: Vec<Level> = (0..4).map(|i| level(comp(i), comp(i), Some([f(i), 1e-4]))).collect();
-        let mut clean = clean;
+        let mut clean: Vec<Level> = (0..4).map(|i| level(comp(i), comp(i), Some([f(i), 1e-4]))).collect();
         clean[3].halvings = 2;
         let c = Estimate::of(&clean).unwrap();
         for (a, b) in e.values().iter().zip(c.values()) {
