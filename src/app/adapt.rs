@@ -108,6 +108,33 @@ impl Level {
     pub fn unknowns(&self) -> usize {
         self.elastic_unknowns + self.pressure_unknowns + 1
     }
+
+    /// The log's line of level `k`.
+    fn log_line(&self, k: usize) -> String {
+        format!(
+            "accuracy: level {k}{}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}{}; estimated error {}",
+            if self.again { format!(" (level {}'s mesh as complementarity)", k - 1) } else { String::new() },
+            self.contact_triangles,
+            self.min_size,
+            self.cut.map_or(String::new(), |c| format!(
+                " (cut to the budget {}: {:.0} % of the marked indicator)",
+                c.by.key(),
+                100.0 * c.share
+            )),
+            self.unknowns(),
+            self.newton_iterations,
+            self.seconds,
+            if self.failed_seconds > 0.0 { format!(" ({:.1} s of them in attempts that failed)", self.failed_seconds) } else { String::new() },
+            self.hc,
+            self.hm,
+            self.hm_at[0],
+            self.hm_at[1],
+            self.pmax,
+            self.friction.map_or(String::new(), |f| format!(", fx = {:.5e}, fz = {:.5e}", f[0], f[1])),
+            self.penalty.filter(|p| p.short()).map_or(String::new(), |p| format!(" (cavitation penalty xi = {:.3e}, short of the scene's {:e})", p.xi, p.scene_xi)),
+            self.est.map_or("- (first level)".to_string(), |e| e.describe())
+        )
+    }
 }
 
 /// A level cut to a budget: it refined the `count` marked triangles of largest indicator,
@@ -447,98 +474,82 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 let solved = collective::agree(&ctx.world, penalty_judged(ctx, &setup, target, solved));
                 match solved {
                     Ok(sol) => sol,
-                    Err(e) if crate::interrupt::agreed() == 0 && tries == Tries::Plain && newton_failed(ctx, &e) => {
-                        ctx.log(format!(
-                            "accuracy: level {k} did not converge by plain Newton on its quartered mesh ({}); again with its {} quartered triangles halved",
-                            reason(&e),
-                            prev.marking.as_ref().map_or(0, |m| m.quartered())
-                        ));
-                        halve_quartered = true;
-                        drop(solver);
-                        tried_s += t0.elapsed().as_secs_f64();
-                        continue;
-                    }
-                    // A level that does not converge with a small gradient-jump factor is
-                    // solved again on the same mesh with it raised, for it and the levels
-                    // after: at M = 100, L = 20 the outlet spike is one element wide on the
-                    // 0.0625 and 0.03125 a levels, Newton moves it from node to node, and
-                    // the alpha ramp stops at 55-63 of 68.3 GPa^-1; with c_J = 1 every level
-                    // converges and hc, hm move by 0.1 %, 0.3 % (docs/accuracy.md, "Newton
-                    // on fine levels at high M and L").
-                    Err(e) if crate::interrupt::agreed() == 0 && raisable && newton_failed(ctx, &e) => {
-                        ctx.log(format!(
-                            "accuracy: level {k} did not converge ({}); again on the same mesh with the gradient-jump factor reynolds.gradient_jump raised from {} to {RAISED_GRADIENT_JUMP} for this level and the ones after",
-                            reason(&e),
-                            scene.reynolds.gradient_jump
-                        ));
-                        raised_from = reached(ctx, &e);
-                        drop(solver);
-                        own.reynolds.gradient_jump = RAISED_GRADIENT_JUMP;
-                        tried_s += t0.elapsed().as_secs_f64();
-                        continue;
-                    }
-                    Err(e) if crate::interrupt::agreed() == 0 && onward_state.is_some() && newton_failed(ctx, &e) => {
-                        ctx.log(format!(
-                            "accuracy: level {k} did not converge from its try's state ({}); again from level {}'s state",
-                            reason(&e),
-                            k - 1
-                        ));
-                        drop(solver);
-                        tried_s += t0.elapsed().as_secs_f64();
-                        continue;
-                    }
-                    // A film that closes next to a spin pole inside the Hertz circle closes on
-                    // every finer mesh: the coarser level converged only because its elements
-                    // do not resolve the pole, so its film is no result (no retry, nothing
-                    // written). The full ladder after such a failure spent 500 s and more
-                    // closing the film at the same node (docs/accuracy.md, "The loop", step 1).
-                    Err(e) if crate::interrupt::agreed() == 0 && at_spin_pole(ctx, &e) => {
-                        drop(solver);
-                        return Err(Error::Context {
-                            context: format!(
-                                "accuracy: level {k} (level {} converged on its coarser mesh only, which does not resolve the spin pole; no result written)",
-                                k - 1
-                            ),
-                            source: Box::new(e),
-                        });
-                    }
-                    Err(e) if crate::interrupt::agreed() == 0 && !last_resorts => {
-                        ctx.log(format!(
-                            "accuracy: level {k} did not converge ({}); again on the same mesh with the load and speed continuations and the Hertz start",
-                            reason(&e)
-                        ));
-                        drop(solver);
-                        full_ladder = Some(k);
-                        tried_s += t0.elapsed().as_secs_f64();
-                        continue;
-                    }
-                    // A goal-oriented level that does not converge is meshed again with the
-                    // previous level's whole pressurised zone refined, once: at M = 100,
-                    // L = 20 the continuation stalled at alpha 62.6 of 68.3 GPa^-1 on the
-                    // goal-oriented 0.125 a level and converged on the zone's.
-                    Err(e) if crate::interrupt::agreed() == 0 && zone_retry == Some(k) => {
-                        ctx.log(format!(
-                            "accuracy: level {k} did not converge on its goal-oriented mesh ({}); again with level {}'s pressurised zone refined",
-                            reason(&e),
-                            k - 1
-                        ));
-                        let edges = longest_edges(&prev.setup.mesh);
-                        let marked = zone_mark(&pf, &edges);
-                        next = Some(NextMesh::halving(Arc::new(next_field(&prev.setup.mesh, &edges, &marked, growth))));
-                        zone_retry = None;
-                        tried_s += t0.elapsed().as_secs_f64();
-                        continue;
-                    }
-                    // A level that does not converge leaves the last converged one as the
-                    // result, labelled as short of its target (an interruption stops).
-                    Err(e) if crate::interrupt::agreed() == 0 => {
-                        let why = short_of(target, &format!("level {k} did not converge ({e})"), k - 1, levels.last().and_then(|l| l.est));
-                        drop(solver);
-                        return finish(ctx, scene, prev, target, &levels, Some(why));
-                    }
+                    // What is tried next, in the order of [`remedy`].
                     Err(e) => {
+                        let tried = Tried {
+                            plain_alone: tries == Tries::Plain,
+                            raisable,
+                            from_try_state: onward_state.is_some(),
+                            last_resorts,
+                            zone_retry: zone_retry == Some(k),
+                        };
+                        let remedy = remedy(&Failure::of(ctx, &e), &tried);
                         drop(solver);
-                        return out_of_time(ctx, scene, Some(prev), k, &levels, e);
+                        match remedy {
+                            Remedy::HalveQuartered => {
+                                ctx.log(format!(
+                                    "accuracy: level {k} did not converge by plain Newton on its quartered mesh ({}); again with its {} quartered triangles halved",
+                                    reason(&e),
+                                    prev.marking.as_ref().map_or(0, |m| m.quartered())
+                                ));
+                                halve_quartered = true;
+                            }
+                            Remedy::Raise => {
+                                ctx.log(format!(
+                                    "accuracy: level {k} did not converge ({}); again on the same mesh with the gradient-jump factor reynolds.gradient_jump raised from {} to {RAISED_GRADIENT_JUMP} for this level and the ones after",
+                                    reason(&e),
+                                    scene.reynolds.gradient_jump
+                                ));
+                                raised_from = reached(ctx, &e);
+                                own.reynolds.gradient_jump = RAISED_GRADIENT_JUMP;
+                            }
+                            Remedy::FromCoarser => {
+                                ctx.log(format!(
+                                    "accuracy: level {k} did not converge from its try's state ({}); again from level {}'s state",
+                                    reason(&e),
+                                    k - 1
+                                ));
+                            }
+                            Remedy::FullLadder => {
+                                ctx.log(format!(
+                                    "accuracy: level {k} did not converge ({}); again on the same mesh with the load and speed continuations and the Hertz start",
+                                    reason(&e)
+                                ));
+                                full_ladder = Some(k);
+                            }
+                            Remedy::ZoneMesh => {
+                                ctx.log(format!(
+                                    "accuracy: level {k} did not converge on its goal-oriented mesh ({}); again with level {}'s pressurised zone refined",
+                                    reason(&e),
+                                    k - 1
+                                ));
+                                let edges = longest_edges(&prev.setup.mesh);
+                                let marked = zone_mark(&pf, &edges);
+                                next = Some(NextMesh::halving(Arc::new(next_field(&prev.setup.mesh, &edges, &marked, growth))));
+                                zone_retry = None;
+                            }
+                            Remedy::SpinPole => {
+                                return Err(Error::Context {
+                                    context: format!(
+                                        "accuracy: level {k} (level {} converged on its coarser mesh only, which does not resolve the spin pole; no result written)",
+                                        k - 1
+                                    ),
+                                    source: Box::new(e),
+                                });
+                            }
+                            Remedy::Short => {
+                                let why = short_of(
+                                    target,
+                                    &format!("level {k} did not converge ({e})"),
+                                    k - 1,
+                                    levels.last().and_then(|l| l.est),
+                                );
+                                return finish(ctx, scene, prev, target, &levels, Some(why));
+                            }
+                            Remedy::Stop => return out_of_time(ctx, scene, Some(prev), k, &levels, e),
+                        }
+                        tried_s += t0.elapsed().as_secs_f64();
+                        continue;
                     }
                 }
             }
@@ -680,29 +691,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let est = Estimate::of(&levels);
         let level = levels.last_mut().expect("the level just pushed");
         level.est = est;
-        ctx.log(format!(
-            "accuracy: level {k}{}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}{}; estimated error {}",
-            if level.again { format!(" (level {}'s mesh as complementarity)", k - 1) } else { String::new() },
-            level.contact_triangles,
-            level.min_size,
-            level.cut.map_or(String::new(), |c| format!(
-                " (cut to the budget {}: {:.0} % of the marked indicator)",
-                c.by.key(),
-                100.0 * c.share
-            )),
-            n_u + n_p + 1,
-            level.newton_iterations,
-            level.seconds,
-            if level.failed_seconds > 0.0 { format!(" ({:.1} s of them in attempts that failed)", level.failed_seconds) } else { String::new() },
-            level.hc,
-            level.hm,
-            level.hm_at[0],
-            level.hm_at[1],
-            level.pmax,
-            level.friction.map_or(String::new(), |f| format!(", fx = {:.5e}, fz = {:.5e}", f[0], f[1])),
-            level.penalty.filter(|p| p.short()).map_or(String::new(), |p| format!(" (cavitation penalty xi = {:.3e}, short of the scene's {:e})", p.xi, p.scene_xi)),
-            level.est.map_or("- (first level)".to_string(), |e| e.describe())
-        ));
+        ctx.log(level.log_line(k));
         let reached = refined >= 2 && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
         let last = reached || !may_go_on;
         let exponents = match (&mut adjoint, scene.output.speed_exponents) {
@@ -839,6 +828,97 @@ fn solve_again<'a>(ctx: &'a Context, scene: &Scene, solver: &EhlSolver<'a>, prev
         coarser,
     };
     solver.solve_from(ctx, scene, start)
+}
+
+/// How a refined level's solve failed, the same on every rank.
+#[derive(Debug, Clone, Copy, Default)]
+struct Failure {
+    /// A signal or the spent time budget stopped it.
+    interrupted: bool,
+    /// Newton's own failure, not at a spin pole ([`newton_failed`]).
+    newton: bool,
+    /// The film closed next to a spin pole inside the Hertz circle ([`at_spin_pole`]).
+    at_pole: bool,
+}
+
+impl Failure {
+    /// Collective.
+    fn of(ctx: &Context, e: &Error) -> Self {
+        if crate::interrupt::agreed() != 0 {
+            return Failure { interrupted: true, ..Failure::default() };
+        }
+        Failure { interrupted: false, newton: newton_failed(ctx, e), at_pole: at_spin_pole(ctx, e) }
+    }
+}
+
+/// What the failed solve of a refined level had tried, and what is left for it.
+#[derive(Debug, Clone, Copy, Default)]
+struct Tried {
+    /// Plain Newton alone, on a mesh made by quartering.
+    plain_alone: bool,
+    /// The gradient-jump factor can still be raised.
+    raisable: bool,
+    /// The solve went on from the furthest state of the try before the raise.
+    from_try_state: bool,
+    /// The load and speed continuations and the Hertz start were among its tries.
+    last_resorts: bool,
+    /// The level is goal-oriented and may be meshed again with the pressurised zone.
+    zone_retry: bool,
+}
+
+/// What a refined level that did not converge is tried with next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Remedy {
+    /// The level meshed again with its quartered triangles halved, which converged by
+    /// plain Newton where the quartered level needed the continuation and the raise (a
+    /// traction drive at L = 22: 62 s to a tighter target against 638 s, docs/practice.md).
+    HalveQuartered,
+    /// The same mesh with the gradient-jump factor raised, for it and the levels after: at
+    /// M = 100, L = 20 the outlet spike is one element wide on the 0.0625 and 0.03125 a
+    /// levels, Newton moves it from node to node, and the alpha ramp stops at 55-63 of
+    /// 68.3 GPa^-1; with c_J = 1 every level converges and hc, hm move by 0.1 %, 0.3 %
+    /// (docs/accuracy.md, "Newton on fine levels at high M and L").
+    Raise,
+    /// The raised solve from the try's furthest state failed: again from the coarser
+    /// level's state.
+    FromCoarser,
+    /// A film that closes next to a spin pole inside the Hertz circle closes on every finer
+    /// mesh: the coarser level converged only because its elements do not resolve the
+    /// pole, so its film is no result (no retry, nothing written). The full ladder after
+    /// such a failure spent 500 s and more closing the film at the same node
+    /// (docs/accuracy.md, "The loop", step 1).
+    SpinPole,
+    /// The same mesh with the load and speed continuations and the Hertz start.
+    FullLadder,
+    /// A goal-oriented level meshed again with the coarser level's whole pressurised zone
+    /// refined, once: at M = 100, L = 20 the continuation stalled at alpha 62.6 of
+    /// 68.3 GPa^-1 on the goal-oriented 0.125 a level and converged on the zone's.
+    ZoneMesh,
+    /// Nothing is left: the last converged level is the result, labelled as short of its
+    /// target.
+    Short,
+    /// An interruption: the run stops (with the last converged level when the time budget
+    /// was spent).
+    Stop,
+}
+
+/// The remedy for a failed refined level, in order: the halved mesh for a quartered one,
+/// the raised gradient-jump factor while it can be raised, the coarser level's state after
+/// a raised solve from the try's state, then (for any failure but a spin pole's) the last
+/// resorts, the zone's mesh, and the last converged level. The raise comes before the last
+/// resorts: at M = 100, L = 20 those cost 330 s on level 3 and never converged from a
+/// coarser level's pressure.
+fn remedy(failed: &Failure, tried: &Tried) -> Remedy {
+    match *failed {
+        Failure { interrupted: true, .. } => Remedy::Stop,
+        Failure { newton: true, .. } if tried.plain_alone => Remedy::HalveQuartered,
+        Failure { newton: true, .. } if tried.raisable => Remedy::Raise,
+        Failure { newton: true, .. } if tried.from_try_state => Remedy::FromCoarser,
+        Failure { at_pole: true, .. } => Remedy::SpinPole,
+        _ if !tried.last_resorts => Remedy::FullLadder,
+        _ if tried.zone_retry => Remedy::ZoneMesh,
+        _ => Remedy::Short,
+    }
 }
 
 /// Whether `e` is Newton's own failure, the same on every rank (not one rank's local
@@ -1062,6 +1142,32 @@ mod tests {
 
     fn closed(message: String) -> Error {
         Error::FilmClosed { message, closed: vec![[0.0, -0.75]], reached: None }
+    }
+
+    #[test]
+    fn a_failed_level_gets_the_cheapest_remedy_left() {
+        let newton = Failure { newton: true, ..Failure::default() };
+        let everything = Tried { plain_alone: true, raisable: true, from_try_state: true, last_resorts: false, zone_retry: true };
+        assert_eq!(remedy(&newton, &everything), Remedy::HalveQuartered);
+        let raisable = Tried { plain_alone: false, ..everything };
+        assert_eq!(remedy(&newton, &raisable), Remedy::Raise);
+        let raised = Tried { raisable: false, ..raisable };
+        assert_eq!(remedy(&newton, &raised), Remedy::FromCoarser);
+        let from_coarser = Tried { from_try_state: false, ..raised };
+        assert_eq!(remedy(&newton, &from_coarser), Remedy::FullLadder);
+        let ladder_tried = Tried { last_resorts: true, ..from_coarser };
+        assert_eq!(remedy(&newton, &ladder_tried), Remedy::ZoneMesh);
+        assert_eq!(remedy(&newton, &Tried { zone_retry: false, ..ladder_tried }), Remedy::Short);
+        // A film closed at a spin pole is no Newton failure to retry: no raise, no ladder.
+        let pole = Failure { at_pole: true, ..Failure::default() };
+        assert_eq!(remedy(&pole, &everything), Remedy::SpinPole);
+        // A failure outside Newton gets only the last resorts and the zone's mesh.
+        let other = Failure::default();
+        assert_eq!(remedy(&other, &everything), Remedy::FullLadder);
+        assert_eq!(remedy(&other, &ladder_tried), Remedy::ZoneMesh);
+        // An interruption is never retried.
+        let stopped = Failure { interrupted: true, newton: true, at_pole: false };
+        assert_eq!(remedy(&stopped, &everything), Remedy::Stop);
     }
 
     #[test]
