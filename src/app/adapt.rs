@@ -11,7 +11,10 @@
 //!    the level without a continuation and fz is no target: `marking::quarters`), keep
 //!    the others'
 //!    (a graded size field on the face, [`crate::mesh::size_field`]), and mesh the solid
-//!    anew under it (conforming bisection).
+//!    anew under it (conforming bisection). From level 1 on, a marking whose next level
+//!    would have fewer than 1.5 times this level's contact triangles is widened to the next
+//!    triangles by indicator until it has them (`widened`): that level may end the run,
+//!    and only a level that refined that much of the face certifies itself.
 //! 3. Solve from the previous level's pressure, interpolated (mesh sequencing), and after a
 //!    monolithic level from its displacement too.
 //! 4. Estimate the error of hc and hm (and fx, fz with friction) from the change between
@@ -40,7 +43,8 @@ use super::estimate::{penalty_in_the_way, Estimate, PenaltyError, PenaltySlopes,
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, PointResult, Setup};
 use super::marking::{
-    cut_count, goal_mark, goals, longest_edges, next_field, quarters, zone_mark, Marking, NextMesh, TimeLeft, MIN_BUDGET_SHARE,
+    cut_count, goal_mark, goals, longest_edges, next_field, quarters, widened_count, zone_mark, Marking, NextMesh, TimeLeft,
+    MIN_BUDGET_SHARE,
 };
 use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
@@ -48,7 +52,7 @@ use crate::case::{CavitationModel, Scene};
 use crate::collective;
 use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, RampLimits, Start, Tries};
 use crate::ehl::post::FieldsOnFace;
-use crate::error::{Error, Reached};
+use crate::error::{Error, Reached, ResultExt};
 use crate::friction::pass::FrictionResult;
 use serde_json::json;
 use std::sync::Arc;
@@ -64,8 +68,17 @@ pub const MIN_ADAPTIVE_SIZE: f64 = 16.0 / 4096.0;
 /// -0.28 % and its estimate said 0.30 %, where its error against the quarter-target film
 /// was +0.6 % (the next levels changed hc by -0.59 % and -0.01 %). On the Moes map the
 /// last levels otherwise grow by 1.8 times or more (docs/accuracy.md, "The Moes map with
-/// no mesh keys").
+/// no mesh keys"). A marking too small for it is widened ([`widened`]); the rule holds
+/// where that cannot be done (no eligible triangle left).
 const CERTIFYING_GROWTH: f64 = 1.5;
+
+/// A widened marking aims at this many times [`CERTIFYING_GROWTH`], so that the power law
+/// of [`widened_count`] lands above the growth from its first extrapolation.
+const WIDENING_AIM: f64 = 1.1;
+
+/// Meshes tried for a widened marking (each a fraction of a second at the sizes where
+/// Doerfler's set is small).
+const MAX_WIDENINGS: usize = 5;
 
 /// Meshes tried for a level cut to the budget (each a fraction of a second at 600,000
 /// unknowns): a cut that still exceeds it is cut again from the meshes tried ([`cut_count`]).
@@ -738,7 +751,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let condensation_s = solver.condensation_s;
         drop(fields);
         drop(solver);
-        let here = Solved {
+        let mut here = Solved {
             setup,
             sol,
             hc: st.hc,
@@ -799,6 +812,17 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
         next = Some(NextMesh::marked(&here.setup.mesh, &edges, marking, None, growth));
+        // The next level may end the run (it is the second refinement or later): a marking
+        // too small for its change to certify it is widened now, while the level is one solve
+        // and not two ([`CERTIFYING_GROWTH`]).
+        if refined >= 1 {
+            let marking = here.marking.as_mut().expect("marked when the loop goes on");
+            match widened(ctx, scene, &here.setup.mesh, &edges, marking, growth, k) {
+                Ok(Some(wide)) => next = Some(wide),
+                Ok(None) => {}
+                Err(e) => return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e),
+            }
+        }
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
             return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
         }
@@ -818,6 +842,56 @@ fn certifies(levels: &[Level]) -> bool {
         }
         _ => false,
     }
+}
+
+/// The next level's mesh from level `k`'s `marking` on `mesh` (`edges`: its longest edges)
+/// widened, when the marking as it is would give the next level fewer than
+/// [`CERTIFYING_GROWTH`] times this level's contact triangles: the next triangles by
+/// indicator are taken ([`Marking::widen`]) until the next level has [`WIDENING_AIM`] times
+/// that growth, the count found from the meshes tried ([`widened_count`]). None when the
+/// marking needs no widening or has nothing left to take. At L = 20 and light load (M = 20,
+/// 50, 100) Doerfler's set on level 1 is 3-7 triangles of the outlet spike; the level made
+/// from them changed the films little whatever their error, could not end the run, and
+/// the levels after it were pre-asymptotic: M = 100, L = 20 then took 5 levels and 739 s,
+/// widened 4 levels and 137 s, with its quarter-target film (docs/accuracy.md, "Markings
+/// of a few triangles, widened").
+fn widened(
+    ctx: &Context,
+    scene: &Scene,
+    mesh: &crate::mesh::Mesh,
+    edges: &[f64],
+    marking: &mut Marking,
+    growth: f64,
+    k: usize,
+) -> Result<Option<NextMesh>, Error> {
+    let before = mesh.contact_tris.len() as u64;
+    let aim = CERTIFYING_GROWTH * before as f64;
+    let doerfler = marking.count();
+    let mut tried: Vec<(usize, u64)> = Vec::new();
+    let mut next = NextMesh::marked(mesh, edges, marking, None, growth);
+    let contact_triangles = |next: &NextMesh| -> Result<u64, Error> {
+        let mut spec = super::dry::mesh_spec(scene, scene.uses_half_domain());
+        spec.size_field = Some(next.field.clone());
+        Ok(crate::mesh::generate(&spec).context("mesh")?.contact_tris.len() as u64)
+    };
+    let mut tris = contact_triangles(&next)?;
+    let first = tris;
+    while (tris as f64) < aim && marking.widens() && tried.len() < MAX_WIDENINGS {
+        tried.push((marking.count(), tris));
+        ctx.log(format!("accuracy: level {k}'s marking of {} triangles gives level {} {tris} contact triangles", marking.count(), k + 1));
+        marking.widen(widened_count(before, &tried, WIDENING_AIM * aim));
+        next = NextMesh::marked(mesh, edges, marking, None, growth);
+        tris = contact_triangles(&next)?;
+    }
+    if tried.is_empty() {
+        return Ok(None);
+    }
+    ctx.log(format!(
+        "accuracy: level {k}'s marking of {doerfler} triangles would give level {} {first} contact triangles, fewer than {CERTIFYING_GROWTH} times its own {before}: widened to its {} triangles of largest indicator ({tris} contact triangles)",
+        k + 1,
+        marking.count(),
+    ));
+    Ok(Some(next))
 }
 
 /// Switches the scene being solved, `own`, to cavitation as complementarity because of

@@ -310,10 +310,7 @@ pub(super) fn goal_mark(
             effects[0], effects[1]
         ));
     }
-    let marked = dorfler_mark(&eta, &eligible(edges), theta);
-    let mut ranked: Vec<(usize, f64)> = (0..n).filter(|&t| marked[t]).map(|t| (t, eta[t])).collect();
-    ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
-    let marking = Marking { marked, ranked: Some(ranked), quarter };
+    let marking = Marking::of(&eta, &eligible(edges), theta, quarter);
     let places = goals.iter().filter(|g| g.name == "hm").count();
     // The hm places are consecutive goals: one name.
     let mut names: Vec<&str> = goals.iter().map(|g| g.name).collect();
@@ -393,19 +390,62 @@ pub(super) struct Marking {
     pub ranked: Option<Vec<(usize, f64)>>,
     /// Whether the triangles of largest indicator are quartered ([`QUARTER_ESTIMATE`]).
     pub quarter: bool,
+    /// The eligible triangles the marking left out, by decreasing indicator: what a
+    /// widened marking takes next ([`Marking::widen`]).
+    rest: Vec<(usize, f64)>,
+    /// The smallest indicator of Doerfler's set, against which triangles are quartered
+    /// (also once the marking is widened).
+    smallest: f64,
 }
 
 impl Marking {
     /// A marking with no ranking (zone marking).
     pub fn unranked(marked: Vec<bool>) -> Marking {
-        Marking { marked, ranked: None, quarter: false }
+        Marking { marked, ranked: None, quarter: false, rest: Vec::new(), smallest: 0.0 }
+    }
+
+    /// Doerfler's marking of the `eligible` triangles at the fraction `theta` of their
+    /// indicators `eta`, ranked, quartering when `quarter`.
+    pub fn of(eta: &[f64], eligible: &[bool], theta: f64, quarter: bool) -> Marking {
+        let marked = dorfler_mark(eta, eligible, theta);
+        let by_indicator = |keep: &dyn Fn(usize) -> bool| {
+            let mut r: Vec<(usize, f64)> = (0..eta.len()).filter(|&t| keep(t)).map(|t| (t, eta[t])).collect();
+            r.sort_by(|a, b| b.1.total_cmp(&a.1));
+            r
+        };
+        let ranked = by_indicator(&|t| marked[t]);
+        let rest = by_indicator(&|t| eligible[t] && !marked[t]);
+        let smallest = ranked.last().map_or(0.0, |v| v.1);
+        Marking { marked, ranked: Some(ranked), quarter, rest, smallest }
+    }
+
+    /// How many triangles the marking refines.
+    pub fn count(&self) -> usize {
+        self.marked.iter().filter(|&&m| m).count()
+    }
+
+    /// Whether [`Marking::widen`] has triangles left to take.
+    pub fn widens(&self) -> bool {
+        self.ranked.is_some() && !self.rest.is_empty()
+    }
+
+    /// Widens the marking to its `count` triangles of largest indicator (at most every
+    /// eligible one; never fewer than it marks): the triangles it takes are halved, since
+    /// quartering stays measured against Doerfler's set.
+    pub fn widen(&mut self, count: usize) {
+        let Some(r) = self.ranked.as_mut() else { return };
+        let take = count.saturating_sub(r.len()).min(self.rest.len());
+        for (t, eta) in self.rest.drain(..take) {
+            self.marked[t] = true;
+            r.push((t, eta));
+        }
     }
 
     /// The indicator from which a marked triangle is quartered ([`QUARTER_RATIO`] times the
-    /// whole marking's smallest), when the marking quarters.
+    /// smallest of Doerfler's set), when the marking quarters.
     fn quarter_from(&self) -> Option<f64> {
-        let r = self.ranked.as_ref().filter(|_| self.quarter)?;
-        Some(QUARTER_RATIO * r.last().map_or(0.0, |v| v.1))
+        self.ranked.as_ref().filter(|_| self.quarter)?;
+        Some(QUARTER_RATIO * self.smallest)
     }
 
     /// The marked triangles the next level quarters (their count).
@@ -525,20 +565,31 @@ impl TimeLeft {
 
 /// How many of the marked triangles (those of largest indicator) a level cut to `budget`
 /// refines, from the meshes tried so far that were over it (`over`: count refined and
-/// unknowns, the whole marking first). The unknowns a level adds grow like a power of the
-/// count, c^p with p below 1: the largest indicators sit on the smallest elements, whose
-/// grading on the face and in the solid reaches far, and the triangles after them share
-/// that grading (spin-0.33deg: p = 0.3-0.5). From one mesh the count is taken in
-/// proportion (p = 1); from two, p is measured between the last two and the power law
-/// extrapolated to [`BUDGET_FILL`] of the budget. Always below the last count tried.
+/// unknowns, the whole marking first): [`count_for`] at [`BUDGET_FILL`] of the budget,
+/// always below the last count tried.
 pub fn cut_count(before: u64, over: &[(usize, u64)], budget: u64) -> usize {
-    let Some(&(c2, n2)) = over.last() else { return 0 };
-    let room = BUDGET_FILL * budget as f64 - before as f64;
+    let Some(&(c2, _)) = over.last() else { return 0 };
+    let c = count_for(before, over, BUDGET_FILL * budget as f64).unwrap_or(0.0);
+    (c as usize).min(c2.saturating_sub(1))
+}
+
+/// How many triangles (those of largest indicator) a level's marking refines for the
+/// level to have `aim` of a size (unknowns or contact triangles) that was `before` on the
+/// level marked, from the meshes tried (`tried`: count refined and size). The size a level
+/// adds grows like a power of the count, c^p with p at most 1: the largest indicators sit
+/// on the smallest elements, whose grading on the face and in the solid reaches far, and
+/// the triangles after them share that grading (spin-0.33deg: p = 0.3-0.5). From one mesh
+/// the count is taken in proportion (p = 1); from two, p is measured between the last two
+/// and the power law extrapolated. None when the last mesh added nothing or the aim is no
+/// more than `before`.
+pub fn count_for(before: u64, tried: &[(usize, u64)], aim: f64) -> Option<f64> {
+    let &(c2, n2) = tried.last()?;
+    let room = aim - before as f64;
     let added = |n: u64| n.saturating_sub(before) as f64;
-    let p = match over.len() {
+    let p = match tried.len() {
         0 | 1 => 1.0,
         k => {
-            let (c1, n1) = over[k - 2];
+            let (c1, n1) = tried[k - 2];
             let p = (added(n1) / added(n2)).ln() / (c1 as f64 / c2 as f64).ln();
             if p.is_finite() {
                 p.clamp(0.1, 1.0)
@@ -547,9 +598,25 @@ pub fn cut_count(before: u64, over: &[(usize, u64)], budget: u64) -> usize {
             }
         }
     };
-    let c = if added(n2) > 0.0 && room > 0.0 { (c2 as f64 * (room / added(n2)).powf(1.0 / p)) as usize } else { 0 };
-    c.min(c2.saturating_sub(1))
+    (added(n2) > 0.0 && room > 0.0).then(|| c2 as f64 * (room / added(n2)).powf(1.0 / p))
 }
+
+/// How many triangles a marking widened for the next level to have `aim` contact
+/// triangles refines, from the meshes tried (`tried`: count refined and contact
+/// triangles; `before`: the level marked): [`count_for`], always above the last count
+/// tried (twice it when the last mesh added nothing) and at most [`WIDENING_STEP`] times
+/// it.
+pub fn widened_count(before: u64, tried: &[(usize, u64)], aim: f64) -> usize {
+    let Some(&(c2, _)) = tried.last() else { return 0 };
+    count_for(before, tried, aim).map_or(2 * c2, |c| c.ceil() as usize).clamp(c2 + 1, WIDENING_STEP * c2)
+}
+
+/// A widened marking takes at most this many times the triangles of the mesh tried before:
+/// the triangles after Doerfler's few share their grading, so the first added ones add
+/// few contact triangles, and a power law measured on them (p near its floor of 0.1)
+/// extrapolates far past the aim (M = 100, L = 20: from 19 triangles to 262, a level of
+/// 2.4 times its predecessor's contact triangles where 1.65 was aimed at).
+pub const WIDENING_STEP: usize = 4;
 
 /// The P2 interpolation weights of the film at `p` (units of a) on the contact face.
 pub(super) fn film_weights(fields: &FieldsOnFace, p: [f64; 2]) -> Result<Vec<(u32, f64)>, Error> {
@@ -641,16 +708,52 @@ mod tests {
         assert_eq!(cut_count(400_000, &[], 600_000), 0);
         // The largest of the ranked: the first of the ranking, whatever their index, and
         // the share of the indicator they carry.
-        let m = Marking { marked: vec![true, false, true, true], ranked: Some(vec![(3, 5.0), (0, 3.0), (2, 2.0)]), quarter: true };
+        let m = Marking::of(&[3.0, 1.0, 2.0, 5.0], &[true; 4], 0.9, true);
+        assert_eq!(m.ranked, Some(vec![(3, 5.0), (0, 3.0), (2, 2.0)]));
         assert_eq!(m.sizes(&[1.0; 4], Some(2)), vec![0.5, 1.0, 1.0, 0.5]);
         assert!((m.indicator_share(2) - 0.8).abs() < 1e-12);
         assert_eq!(Marking::unranked(vec![true, false]).sizes(&[1.0, 1.0], Some(0)), vec![0.5, 1.0]);
     }
 
     #[test]
+    fn a_widened_marking_takes_the_next_triangles_by_indicator_and_halves_them() {
+        // Doerfler at 0.5 takes 40 of 40, 8, 4, 2, 1 (and 0.5 not eligible); quartering from
+        // 16 times it, so nothing is quartered even once triangles of smaller indicator join.
+        let mut m = Marking::of(&[4.0, 40.0, 2.0, 8.0, 0.5, 1.0], &[true, true, true, true, false, true], 0.5, true);
+        assert_eq!(m.count(), 1);
+        m.widen(3);
+        assert_eq!(m.marked, vec![true, true, false, true, false, false]);
+        assert_eq!(m.quartered(), 0);
+        assert_eq!(m.sizes(&[1.0; 6], None), vec![0.5, 0.5, 1.0, 0.5, 1.0, 1.0]);
+        // Never narrowed, and never beyond the eligible triangles.
+        m.widen(2);
+        assert_eq!(m.count(), 3);
+        m.widen(10);
+        assert_eq!(m.count(), 5);
+        assert!(!m.widens());
+        assert!(!Marking::unranked(vec![true, false]).widens());
+    }
+
+    #[test]
+    fn a_widened_count_aims_at_the_growth_from_the_meshes_tried() {
+        // M = 100, L = 20's level 1: 965 contact triangles, 7 marked gave 1,201. For 1,592
+        // (1.65 times), in proportion: 7 * 627 / 236, rounded up.
+        assert_eq!(widened_count(965, &[(7, 1201)], 1592.0), 19);
+        // 19 gave 1,400: p = ln(236/435)/ln(7/19) = 0.61, so 19 (627/435)^(1/p).
+        let p = (236.0f64 / 435.0).ln() / (7.0f64 / 19.0).ln();
+        let want = (19.0 * (627.0f64 / 435.0).powf(1.0 / p)).ceil() as usize;
+        assert_eq!(widened_count(965, &[(7, 1201), (19, 1400)], 1592.0), want);
+        // A mesh that grew little from the count before: at most 4 times the count.
+        assert_eq!(widened_count(965, &[(7, 1201), (19, 1215)], 1592.0), 76);
+        // Always more than the last count; twice it when the last mesh added nothing.
+        assert_eq!(widened_count(965, &[(7, 1700)], 1592.0), 8);
+        assert_eq!(widened_count(965, &[(7, 965)], 1592.0), 14);
+    }
+
+    #[test]
     fn a_marked_triangle_far_above_the_smallest_marked_indicator_is_quartered() {
         // Indicators 40, 32, 3, 2: 32 is 16 times the smallest marked one, 3 is not.
-        let mut m = Marking { marked: vec![true; 4], ranked: Some(vec![(1, 40.0), (0, 32.0), (3, 3.0), (2, 2.0)]), quarter: true };
+        let mut m = Marking::of(&[32.0, 40.0, 2.0, 3.0], &[true; 4], 1.0, true);
         assert_eq!(m.quartered(), 2);
         assert_eq!(m.sizes(&[0.25; 4], None), vec![0.0625, 0.0625, 0.125, 0.125]);
         // Cut to the largest one: the others keep their size; the threshold stays the whole
