@@ -952,7 +952,7 @@ impl Failure {
 }
 
 /// What the failed solve of a refined level had tried, and what is left for it.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 struct Tried {
     /// Plain Newton alone, on a mesh made by quartering.
     plain_alone: bool,
