@@ -68,9 +68,21 @@ pub const MIN_ADAPTIVE_SIZE: f64 = 16.0 / 4096.0;
 /// -0.28 % and its estimate said 0.30 %, where its error against the quarter-target film
 /// was +0.6 % (the next levels changed hc by -0.59 % and -0.01 %). On the Moes map the
 /// last levels otherwise grow by 1.8 times or more (docs/accuracy.md, "The Moes map with
-/// no mesh keys"). A marking too small for it is widened ([`widened`]); the rule holds
-/// where that cannot be done (no eligible triangle left).
+/// no mesh keys"). It holds for a level made from a marking of fewer than [`FEW_MARKED`]
+/// triangles; such a marking is widened ([`widened`]), and the rule holds where that cannot
+/// be done (no eligible triangle left).
 const CERTIFYING_GROWTH: f64 = 1.5;
+
+/// A marking of fewer triangles than this refines one feature a few elements wide (the
+/// outlet spike at L = 20 and light load: 3-7 triangles; M = 200, L = 20: 22), and the
+/// level made from it is held to [`CERTIFYING_GROWTH`]. A larger marking's level
+/// certifies itself whatever its growth: on a fine face at high load Doerfler's set is a
+/// small share of the triangles because the error sits in thin side lobes, and each level
+/// grows the face by 1.33-1.39 times (cases/hard/heavy-3gpa: 94, 132 and 254 triangles
+/// on levels 1-3). Widened to 1.5 times there, its levels reached the unknowns budget at
+/// level 3 with estimates of 11 % and 7 %, where the levels as marked reach 0.01 at level
+/// 4 with 540,644 unknowns (docs/accuracy.md, "Markings of a few triangles, widened").
+const FEW_MARKED: usize = 32;
 
 /// A widened marking aims at this many times [`CERTIFYING_GROWTH`], so that the power law
 /// of [`widened_count`] lands above the growth from its first extrapolation.
@@ -124,6 +136,9 @@ pub struct Level {
     /// level's place, and the levels before it count less the penalty's error this one
     /// measured (`estimate::sequence`).
     pub again: bool,
+    /// How many triangles the level's marking refines for the next level (after any
+    /// widening; None before it marks, or without a marking).
+    pub marked: Option<usize>,
 }
 
 impl Level {
@@ -669,6 +684,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             // Set below, once the slopes are known.
             penalty: None,
             again: std::mem::take(&mut again),
+            marked: None,
         };
         over.clear();
         levels.push(level);
@@ -746,7 +762,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         };
         drop(adjoint);
         // A level's time includes its adjoint and the marking of the next one.
-        levels.last_mut().expect("the level just pushed").seconds = tried_s + t0.elapsed().as_secs_f64();
+        let pushed = levels.last_mut().expect("the level just pushed");
+        pushed.seconds = tried_s + t0.elapsed().as_secs_f64();
+        pushed.marked = marked.as_ref().map(|m| m.count());
         tried_s = 0.0;
         let condensation_s = solver.condensation_s;
         drop(fields);
@@ -818,7 +836,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         if refined >= 1 {
             let marking = here.marking.as_mut().expect("marked when the loop goes on");
             match widened(ctx, scene, &here.setup.mesh, &edges, marking, growth, k) {
-                Ok(Some(wide)) => next = Some(wide),
+                Ok(Some(wide)) => {
+                    next = Some(wide);
+                    levels.last_mut().expect("the level just pushed").marked = Some(marking.count());
+                }
                 Ok(None) => {}
                 Err(e) => return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e),
             }
@@ -838,14 +859,17 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
 fn certifies(levels: &[Level]) -> bool {
     match levels {
         [.., before, last] => {
-            last.again || last.cut.is_some() || last.contact_triangles as f64 >= CERTIFYING_GROWTH * before.contact_triangles as f64
+            last.again
+                || last.cut.is_some()
+                || before.marked.is_some_and(|m| m >= FEW_MARKED)
+                || last.contact_triangles as f64 >= CERTIFYING_GROWTH * before.contact_triangles as f64
         }
         _ => false,
     }
 }
 
 /// The next level's mesh from level `k`'s `marking` on `mesh` (`edges`: its longest edges)
-/// widened, when the marking as it is would give the next level fewer than
+/// widened, when the marking has fewer than [`FEW_MARKED`] triangles and as it is would give the next level fewer than
 /// [`CERTIFYING_GROWTH`] times this level's contact triangles: the next triangles by
 /// indicator are taken ([`Marking::widen`]) until the next level has [`WIDENING_AIM`] times
 /// that growth, the count found from the meshes tried ([`widened_count`]). None when the
@@ -867,6 +891,9 @@ fn widened(
     let before = mesh.contact_tris.len() as u64;
     let aim = CERTIFYING_GROWTH * before as f64;
     let doerfler = marking.count();
+    if doerfler >= FEW_MARKED {
+        return Ok(None);
+    }
     let mut tried: Vec<(usize, u64)> = Vec::new();
     let mut next = NextMesh::marked(mesh, edges, marking, None, growth);
     let contact_triangles = |next: &NextMesh| -> Result<u64, Error> {
@@ -1264,9 +1291,12 @@ mod tests {
             halvings: 1,
             penalty: None,
             again: false,
+            marked: Some(7),
         };
         // M = 100, L = 20: 7 of level 1's 965 triangles marked, 1,201 on level 2.
         assert!(!certifies(&[level(720), level(965), level(1201)]));
+        // heavy-3gpa: level 3's marking of 254 of its 17,216 triangles, 23,428 on level 4.
+        assert!(certifies(&[level(12000), Level { marked: Some(254), ..level(17216) }, level(23428)]));
         // M = 20, L = 15, the smallest growth of the map's other last levels.
         assert!(certifies(&[level(720), level(869), level(1594)]));
         // The same mesh as complementarity, and a level cut to the budget, are judged by

@@ -518,6 +518,7 @@ mod tests {
             halvings: 1,
             penalty: None,
             again: false,
+            marked: None,
         }
     }
 
