@@ -11,10 +11,11 @@
 //!    the level without a continuation and fz is no target: `marking::quarters`), keep
 //!    the others'
 //!    (a graded size field on the face, [`crate::mesh::size_field`]), and mesh the solid
-//!    anew under it (conforming bisection). From level 1 on, a marking whose next level
-//!    would have fewer than 1.5 times this level's contact triangles is widened to the next
-//!    triangles by indicator until it has them (`widened`): that level may end the run,
-//!    and only a level that refined that much of the face certifies itself.
+//!    anew under it (conforming bisection). From level 1 on, a marking of fewer than 32
+//!    triangles whose next level would have fewer than 1.5 times this level's contact
+//!    triangles is widened to the next triangles by indicator until it has them
+//!    (`widened`): that level may end the run, and a level made from so few triangles
+//!    certifies itself only with that growth (`certifies`).
 //! 3. Solve from the previous level's pressure, interpolated (mesh sequencing), and after a
 //!    monolithic level from its displacement too.
 //! 4. Estimate the error of hc and hm (and fx, fz with friction) from the change between
@@ -52,7 +53,7 @@ use crate::case::{CavitationModel, Scene};
 use crate::collective;
 use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, RampLimits, Start, Tries};
 use crate::ehl::post::FieldsOnFace;
-use crate::error::{Error, Reached, ResultExt};
+use crate::error::{Error, Reached};
 use crate::friction::pass::FrictionResult;
 use serde_json::json;
 use std::sync::Arc;
@@ -829,20 +830,19 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             let why = short_of(target, &format!("every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"), k, est);
             return finish(ctx, scene, &here, target, &levels, Some(why));
         }
-        next = Some(NextMesh::marked(&here.setup.mesh, &edges, marking, None, growth));
+        let marked_next = NextMesh::marked(&here.setup.mesh, &edges, marking, None, growth);
         // The next level may end the run (it is the second refinement or later): a marking
-        // too small for its change to certify it is widened now, while the level is one solve
-        // and not two ([`CERTIFYING_GROWTH`]).
+        // of a few triangles, too small for its change to certify it, is widened now, while
+        // the level is one solve and not two ([`FEW_MARKED`]).
         if refined >= 1 {
             let marking = here.marking.as_mut().expect("marked when the loop goes on");
-            match widened(ctx, scene, &here.setup.mesh, &edges, marking, growth, k) {
-                Ok(Some(wide)) => {
-                    next = Some(wide);
-                    levels.last_mut().expect("the level just pushed").marked = Some(marking.count());
-                }
-                Ok(None) => {}
+            match widened(ctx, scene, &here.setup.mesh, &edges, marking, marked_next, k) {
+                Ok(wide) => next = Some(wide),
                 Err(e) => return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e),
             }
+            levels.last_mut().expect("the level just pushed").marked = Some(marking.count());
+        } else {
+            next = Some(marked_next);
         }
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
             return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
@@ -851,8 +851,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
     }
 }
 
-/// Whether the last of `levels` may end the run when its estimate is below the target: it
-/// refined enough of the face over the level before ([`CERTIFYING_GROWTH`]), or it is that
+/// Whether the last of `levels` may end the run when its estimate is below the target: the
+/// level before's marking had [`FEW_MARKED`] triangles or more, or the level refined enough
+/// of the face over the level before ([`CERTIFYING_GROWTH`]), or it is that
 /// level's mesh solved again as complementarity (whose estimate is the penalty level's
 /// mesh part), or a level cut to the budget (whose estimate is the level before's less its
 /// change).
@@ -868,12 +869,13 @@ fn certifies(levels: &[Level]) -> bool {
     }
 }
 
-/// The next level's mesh from level `k`'s `marking` on `mesh` (`edges`: its longest edges)
-/// widened, when the marking has fewer than [`FEW_MARKED`] triangles and as it is would give the next level fewer than
-/// [`CERTIFYING_GROWTH`] times this level's contact triangles: the next triangles by
-/// indicator are taken ([`Marking::widen`]) until the next level has [`WIDENING_AIM`] times
-/// that growth, the count found from the meshes tried ([`widened_count`]). None when the
-/// marking needs no widening or has nothing left to take. At L = 20 and light load (M = 20,
+/// The next level's mesh from level `k`'s `marking` on `mesh` (`edges`: its longest edges;
+/// `marked`: the marking's own mesh, returned as it is when it needs no widening). A
+/// marking of fewer than [`FEW_MARKED`] triangles that would give the next level fewer than
+/// [`CERTIFYING_GROWTH`] times this level's contact triangles is widened: the next
+/// triangles by indicator are taken ([`Marking::widen`]) until the next level has
+/// [`WIDENING_AIM`] times that growth, the count found from the meshes tried
+/// ([`widened_count`]), or until nothing is left to take. At L = 20 and light load (M = 20,
 /// 50, 100) Doerfler's set on level 1 is 3-7 triangles of the outlet spike; the level made
 /// from them changed the films little whatever their error, could not end the run, and
 /// the levels after it were pre-asymptotic: M = 100, L = 20 then took 5 levels and 739 s,
@@ -885,21 +887,19 @@ fn widened(
     mesh: &crate::mesh::Mesh,
     edges: &[f64],
     marking: &mut Marking,
-    growth: f64,
+    marked: NextMesh,
     k: usize,
-) -> Result<Option<NextMesh>, Error> {
+) -> Result<NextMesh, Error> {
     let before = mesh.contact_tris.len() as u64;
     let aim = CERTIFYING_GROWTH * before as f64;
     let doerfler = marking.count();
     if doerfler >= FEW_MARKED {
-        return Ok(None);
+        return Ok(marked);
     }
     let mut tried: Vec<(usize, u64)> = Vec::new();
-    let mut next = NextMesh::marked(mesh, edges, marking, None, growth);
+    let mut next = marked;
     let contact_triangles = |next: &NextMesh| -> Result<u64, Error> {
-        let mut spec = super::dry::mesh_spec(scene, scene.uses_half_domain());
-        spec.size_field = Some(next.field.clone());
-        Ok(crate::mesh::generate(&spec).context("mesh")?.contact_tris.len() as u64)
+        Ok(super::lubricated::solid_mesh(scene, scene.uses_half_domain(), Some(next.field.clone()))?.contact_tris.len() as u64)
     };
     let mut tris = contact_triangles(&next)?;
     let first = tris;
@@ -907,18 +907,18 @@ fn widened(
         tried.push((marking.count(), tris));
         ctx.log(format!("accuracy: level {k}'s marking of {} triangles gives level {} {tris} contact triangles", marking.count(), k + 1));
         marking.widen(widened_count(before, &tried, WIDENING_AIM * aim));
-        next = NextMesh::marked(mesh, edges, marking, None, growth);
+        next = NextMesh::marked(mesh, edges, marking, None, scene.mesh.growth);
         tris = contact_triangles(&next)?;
     }
     if tried.is_empty() {
-        return Ok(None);
+        return Ok(next);
     }
     ctx.log(format!(
         "accuracy: level {k}'s marking of {doerfler} triangles would give level {} {first} contact triangles, fewer than {CERTIFYING_GROWTH} times its own {before}: widened to its {} triangles of largest indicator ({tris} contact triangles)",
         k + 1,
         marking.count(),
     ));
-    Ok(Some(next))
+    Ok(next)
 }
 
 /// Switches the scene being solved, `own`, to cavitation as complementarity because of

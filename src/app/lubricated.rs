@@ -29,6 +29,14 @@ pub struct Setup {
     pub worst_quality: f64,
 }
 
+/// The elastic scene's mesh (the equivalent cube with its contact face) under the size
+/// field `field` (None: the scene's own mesh keys), on the half domain when `half`.
+pub fn solid_mesh(scene: &Scene, half: bool, field: Option<std::sync::Arc<crate::mesh::size_field::SizeField>>) -> Result<Mesh, Error> {
+    let mut spec = super::dry::mesh_spec(scene, half);
+    spec.size_field = field;
+    mesh::generate(&spec).context("mesh")
+}
+
 impl Setup {
     pub fn new(ctx: &Context, scene: &Scene) -> Result<Setup, Error> {
         Self::with_size_field(ctx, scene, None)
@@ -53,9 +61,7 @@ impl Setup {
             let p = mesh::face::face_partition(&m, ctx.size);
             (m, p)
         } else {
-            let mut spec = super::dry::mesh_spec(scene, half);
-            spec.size_field = field;
-            let m = mesh::generate(&spec).context("mesh")?;
+            let m = solid_mesh(scene, half, field)?;
             let p = mesh::partition(&m, ctx.size);
             (m, p)
         };
