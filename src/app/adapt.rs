@@ -349,8 +349,17 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 None => format!("level {k} would have {n} unknowns, above accuracy.max_unknowns = {}", acc.max_unknowns),
             };
             let ranked = prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| over.len() < MAX_CUTS);
-            let hopeful =
-                ranked.is_some() && Estimate::cut_could_reach(&levels, target, scene.effects.cavitation == CavitationModel::Penalty);
+            // The cut this mesh leads to: its count from the meshes tried, and its share of
+            // the marked indicator.
+            let planned = ranked.map(|(m, marked)| {
+                let mut tried = over.clone();
+                tried.push((cut.map_or(marked, |c| c.count), n));
+                let count = cut_count(before, &tried, budget);
+                (tried, count, m.indicator_share(count))
+            });
+            let hopeful = planned
+                .as_ref()
+                .is_some_and(|p| Estimate::cut_worth_solving(&levels, target, scene.effects.cavitation == CavitationModel::Penalty, p.2));
             // A cut level kept from the target by the cavitation penalty's part alone: the
             // level before is solved again as complementarity, and the cut is gated and
             // estimated on that sequence (below, step 7 of the module documentation).
@@ -366,10 +375,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 again = true;
                 continue;
             }
-            if let Some((m, marked)) = ranked.filter(|_| hopeful) {
-                over.push((cut.map_or(marked, |c| c.count), n));
-                let count = cut_count(before, &over, budget);
-                let share = m.indicator_share(count);
+            if let (Some((m, marked)), Some((tried, count, share))) = (ranked.filter(|_| hopeful), &planned) {
+                let (count, share) = (*count, *share);
+                over = tried.clone();
                 if share >= MIN_BUDGET_SHARE {
                     ctx.log(format!(
                         "accuracy: {over_what}; it refines the {count} of the {marked} marked triangles with the largest indicator instead ({:.0} % of their indicator)",
@@ -382,7 +390,13 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             }
             let why = format!(
                 "{over_what}{}",
-                if ranked.is_some() && !hopeful { " (a level cut to it could not take every estimate below the target)" } else { "" }
+                match (&planned, ranked) {
+                    (Some((_, count, share)), Some((_, marked))) if !hopeful => format!(
+                        " (a level cut to it, the {count} of the {marked} marked triangles with the largest indicator, {:.0} % of it, could not take every estimate below the target)",
+                        100.0 * share
+                    ),
+                    _ => String::new(),
+                }
             );
             let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
             return finish(ctx, scene, prev, target, &levels, Some(why));

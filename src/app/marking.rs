@@ -293,13 +293,23 @@ pub(super) fn goal_mark(
     let (mut eta, mut from_jumps) = (vec![0.0; n], 0.0);
     // The term's first-order effect on each value, relative to it (%).
     let mut effects = Vec::with_capacity(goals.len());
-    for Goal { z, scale: v, .. } in goals {
+    // Each goal's part of the summed indicator, by name (the hm places are consecutive
+    // goals: one part), for the log.
+    let mut parts: Vec<(&str, f64)> = Vec::new();
+    for Goal { name, z, scale: v } in goals {
         let terms = edge_terms(&jumps, &p, z);
         effects.push(100.0 * terms.iter().sum::<f64>() / v);
         let shares = triangle_shares(&jumps, n, &terms);
+        let mut sum = 0.0;
         for (t, tri) in mesh.contact_tris.iter().enumerate() {
-            eta[t] += (rho[t] * surplus(z, tri) + shares[t]) / v.abs();
+            let e = (rho[t] * surplus(z, tri) + shares[t]) / v.abs();
+            eta[t] += e;
+            sum += e;
             from_jumps += shares[t] / v.abs();
+        }
+        match parts.last_mut() {
+            Some((last, s)) if last == name => *s += sum,
+            _ => parts.push((name, sum)),
         }
     }
     if !jumps.is_empty() {
@@ -311,13 +321,11 @@ pub(super) fn goal_mark(
         ));
     }
     let marking = Marking::of(&eta, &eligible(edges), theta, quarter);
+    let total: f64 = parts.iter().map(|(_, s)| s).sum();
     let places = goals.iter().filter(|g| g.name == "hm").count();
-    // The hm places are consecutive goals: one name.
-    let mut names: Vec<&str> = goals.iter().map(|g| g.name).collect();
-    names.dedup();
     ctx.log(format!(
-        "accuracy: goal-oriented marking ({}{}): {} of {} contact triangles marked ({} of them quartered; fraction {theta} of the weighted indicator{}), {:.1} s",
-        names.join(", "),
+        "accuracy: goal-oriented marking (the weighted indicator: {}{}): {} of {} contact triangles marked ({} of them quartered; fraction {theta} of the weighted indicator{}), {:.1} s",
+        parts.iter().map(|(name, s)| format!("{name} {:.0} %", 100.0 * s / total)).collect::<Vec<_>>().join(", "),
         if places > 1 { format!("; hm at {places} places") } else { String::new() },
         marking.marked.iter().filter(|&&m| m).count(),
         marking.marked.len(),
