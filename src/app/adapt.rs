@@ -28,7 +28,9 @@
 //!    that rho is measured).
 //! 5. A next level above `accuracy.max_unknowns` refines only the marked triangles of
 //!    largest indicator that fit (`marking::cut_count`), once per run; its
-//!    estimate is the one before it less its change (`estimate_after_cut`).
+//!    estimate is the one before it less its change (`estimate_after_cut`), unless it
+//!    keeps 90 % of the marked indicator: then it is estimated and gated as a full level
+//!    (`Estimate::cut_worth_solving`).
 //! 6. When the target cannot be reached (`accuracy.max_levels` levels solved, the next
 //!    level above `accuracy.max_unknowns` with too little room for a cut, or every
 //!    triangle at the smallest size), the
