@@ -188,6 +188,31 @@ pub struct Cut {
     pub by: Budget,
 }
 
+/// The cut a level over its budget leads to, before it is decided: the marking it refines
+/// a part of (`marked` triangles), the meshes tried for it with the last one over the
+/// budget (count refined, unknowns), and the `count` of largest indicator to refine with
+/// their `share` of the marked indicator ([`cut_count`]).
+struct PlannedCut<'a> {
+    marking: &'a Marking,
+    marked: usize,
+    tried: Vec<(usize, u64)>,
+    count: usize,
+    share: f64,
+}
+
+impl<'a> PlannedCut<'a> {
+    /// From `marking`, the meshes tried so far (`over`), the cut the last of them refined
+    /// (None: the whole marking), its `n` unknowns, the level before's `before` unknowns and
+    /// the `budget`. None when the marking has no ranking (zone marking).
+    fn of(marking: &'a Marking, over: &[(usize, u64)], cut: Option<Cut>, n: u64, before: u64, budget: u64) -> Option<Self> {
+        let marked = marking.ranked.as_ref()?.len();
+        let mut tried = over.to_vec();
+        tried.push((cut.map_or(marked, |c| c.count), n));
+        let count = cut_count(before, &tried, budget);
+        Some(PlannedCut { marking, marked, tried, count, share: marking.indicator_share(count) })
+    }
+}
+
 /// The budget a level is cut to: `accuracy.max_unknowns`, or the unknowns the time left of
 /// `accuracy.max_seconds` allows.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -350,22 +375,17 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 ),
                 None => format!("level {k} would have {n} unknowns, above accuracy.max_unknowns = {}", acc.max_unknowns),
             };
-            let ranked = prev.marking.as_ref().and_then(|m| m.ranked.as_ref().map(|r| (m, r.len()))).filter(|_| over.len() < MAX_CUTS);
-            // The cut this mesh leads to: its count from the meshes tried, and its share of
-            // the marked indicator.
-            let planned = ranked.map(|(m, marked)| {
-                let mut tried = over.clone();
-                tried.push((cut.map_or(marked, |c| c.count), n));
-                let count = cut_count(before, &tried, budget);
-                (tried, count, m.indicator_share(count))
+            // The cut this mesh leads to (none without a ranked marking, or after
+            // [`MAX_CUTS`] meshes).
+            let planned =
+                prev.marking.as_ref().filter(|_| over.len() < MAX_CUTS).and_then(|m| PlannedCut::of(m, &over, cut, n, before, budget));
+            let hopeful = planned.as_ref().is_some_and(|p| {
+                Estimate::cut_worth_solving(&levels, target, scene.effects.cavitation == CavitationModel::Penalty, p.share)
             });
-            let hopeful = planned
-                .as_ref()
-                .is_some_and(|p| Estimate::cut_worth_solving(&levels, target, scene.effects.cavitation == CavitationModel::Penalty, p.2));
             // A cut level kept from the target by the cavitation penalty's part alone: the
             // level before is solved again as complementarity, and the cut is gated and
             // estimated on that sequence (below, step 7 of the module documentation).
-            let penalty_alone = ranked.is_some()
+            let penalty_alone = planned.is_some()
                 && !hopeful
                 && scene.effects.cavitation == CavitationModel::Penalty
                 && levels.last().is_some_and(|l| l.penalty.is_some())
@@ -377,29 +397,27 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 again = true;
                 continue;
             }
-            if let (Some((m, marked)), Some((tried, count, share))) = (ranked.filter(|_| hopeful), &planned) {
-                let (count, share) = (*count, *share);
-                over = tried.clone();
+            let refused = planned.as_ref().filter(|_| !hopeful).map(|p| {
+                format!(
+                    " (a level cut to it, the {} of the {} marked triangles with the largest indicator, {:.0} % of it, could not take every estimate below the target)",
+                    p.count,
+                    p.marked,
+                    100.0 * p.share
+                )
+            });
+            if let Some(PlannedCut { marking, marked, tried, count, share }) = planned.filter(|_| hopeful) {
+                over = tried;
                 if share >= MIN_BUDGET_SHARE {
                     ctx.log(format!(
                         "accuracy: {over_what}; it refines the {count} of the {marked} marked triangles with the largest indicator instead ({:.0} % of their indicator)",
                         100.0 * share
                     ));
-                    next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), m, Some(count), growth));
+                    next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), marking, Some(count), growth));
                     cut = Some(Cut { count, share, by: if by_time.is_some() { Budget::Seconds } else { Budget::Unknowns } });
                     continue;
                 }
             }
-            let why = format!(
-                "{over_what}{}",
-                match (&planned, ranked) {
-                    (Some((_, count, share)), Some((_, marked))) if !hopeful => format!(
-                        " (a level cut to it, the {count} of the {marked} marked triangles with the largest indicator, {:.0} % of it, could not take every estimate below the target)",
-                        100.0 * share
-                    ),
-                    _ => String::new(),
-                }
-            );
+            let why = format!("{over_what}{}", refused.unwrap_or_default());
             let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
             return finish(ctx, scene, prev, target, &levels, Some(why));
         }
