@@ -37,6 +37,10 @@ pub struct EhlOptions {
     /// iterations stays above [`NEWTON_STALL_FACTOR`] times the smallest before them stops
     /// as stalled (0: never).
     pub newton_stall: usize,
+    /// `-ehl_memory_per_rank GB`: the resident memory a rank may reach, which bounds the
+    /// levels of an adaptive run (`app::memory`); None: what the node has free, shared
+    /// among this run's ranks on it.
+    pub memory_per_rank_gb: Option<f64>,
 }
 
 impl Default for EhlOptions {
@@ -52,6 +56,7 @@ impl Default for EhlOptions {
             fail_point: None,
             plot_font: None,
             newton_stall: NEWTON_STALL,
+            memory_per_rank_gb: None,
         }
     }
 }
@@ -117,8 +122,19 @@ pub fn read(comm: petsc::ffi::MPI_Comm) -> petsc::Result<&'static EhlOptions> {
             d.newton_stall as i32,
         )?
         .map_or(d.newton_stall, |n| n.max(0) as usize);
+    let memory_per_rank_gb = g.real(
+        "-ehl_memory_per_rank",
+        "Resident memory (GB) a rank may reach: an adaptive run solves no level predicted to need more (default: the node's free memory shared among the run's ranks on it)",
+        0.0,
+    )?;
     let plot_font = g.string("-ehl_plot_font", "TrueType font file for the plots", crate::output::plot::FONT_PATH)?;
     g.end()?;
+    if let Some(v) = memory_per_rank_gb.filter(|v| !(v.is_finite() && *v > 0.0)) {
+        return Err(petsc::PetscError {
+            code: petsc::ffi::PETSC_ERR_ARG_OUTOFRANGE as i32,
+            message: format!("-ehl_memory_per_rank = {v}: the memory a rank may use must be a positive number of GB"),
+        });
+    }
     let o = EhlOptions {
         monitor,
         check_jacobian,
@@ -130,6 +146,7 @@ pub fn read(comm: petsc::ffi::MPI_Comm) -> petsc::Result<&'static EhlOptions> {
         fail_point,
         plot_font,
         newton_stall,
+        memory_per_rank_gb,
     };
     Ok(OPTIONS.get_or_init(|| o))
 }

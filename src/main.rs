@@ -14,7 +14,7 @@ Defaults: -ksp_type preonly -pc_type lu; MUMPS (-mat_mumps_icntl_7 4, PORD) for 
   the dense condensed EHL Jacobian: -pc_factor_mat_solver_type scalapack (2+ ranks) or petsc
   (LAPACK, 1 rank); -condensed_mat_type aij -pc_factor_mat_solver_type mumps returns to MUMPS.
 Useful: -log_view, -ksp_view, -options_left (lists options nobody used), -mat_mumps_icntl_4 2.
-The solver's own options (-ehl_monitor, -ehl_check_jacobian, -ehl_supg_delta, ...) are listed
+The solver's own options (-ehl_monitor, -ehl_memory_per_rank GB, -ehl_supg_delta, ...) are listed
   with the others by -help after the scene.
 Exit codes: 0 success, 1 solve failed or did not converge, 2 bad command line, scene or output folder
   (also an output folder in use by another run), 3 MPI or PETSc start-up (all ranks end),

@@ -370,6 +370,43 @@ fn a_level_over_the_budget_refines_the_share_of_its_marking_that_fits() {
     assert_eq!(s["film"]["hc_m"], acc["levels"][2]["hc_m"], "{s}");
 }
 
+/// A level predicted not to fit the memory a rank may reach is not begun: the run writes
+/// the last level's result, labelled, and exits 4 instead of being killed by the kernel
+/// with nothing written. With `-ehl_memory_per_rank 0.1` (less than the 0.2-0.3 GB a rank
+/// of this point holds from its first level on) level 1's predicted peak is above it; the
+/// first level is solved whatever the budgets, so that a run always has a result. The level
+/// reports the peak resident memory of its largest rank, as the kernel measured it.
+#[test]
+fn a_level_predicted_over_the_memory_is_not_begun_and_the_run_says_so() {
+    let dir = scratch("accuracy_memory");
+    let scene = repo().join("cases/references/moes-m10-l6.toml");
+    let run = dir.join("run");
+    let args = [
+        scene.to_str().unwrap(),
+        "--output",
+        run.to_str().unwrap(),
+        "--set",
+        "accuracy.target=0.05",
+        "--set",
+        "mesh.contact_size=0.5",
+        "-ehl_memory_per_rank",
+        "0.1",
+    ];
+    let out = mpirun(2, &args);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(4), "{log}");
+    assert!(log.contains("GB per rank from level 0's peak") && log.contains("(-ehl_memory_per_rank)"), "{log}");
+    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).unwrap()).unwrap();
+    let acc = &s["accuracy"];
+    assert_eq!(acc["reached"], false, "{acc}");
+    assert!(acc["not_reached_because"].as_str().unwrap().contains("0.1 GB a rank may reach"), "{acc}");
+    let levels = acc["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 1, "{acc}");
+    assert_eq!(s["film"]["hc_m"], levels[0]["hc_m"], "{s}");
+    let peak = levels[0]["peak_memory_per_rank_mb"].as_f64().unwrap();
+    assert!(peak > 100.0 && peak < 4096.0, "{peak} MB");
+}
+
 /// A time budget spent during a level abandons that level on every rank: the last converged
 /// level's result is written, labelled with the reason, and the run exits 4. With a budget
 /// of 1 s the first level (which always runs to its end) has spent it, so level 1 stops at

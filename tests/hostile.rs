@@ -270,6 +270,12 @@ fn cases(dir: &Path) -> Vec<Case> {
         3,
         &["-ehl_monitor", "true or false", "maybe"],
     ));
+    v.push(case(
+        "ehl-option-memory-not-positive",
+        &[&t2, "--set", "mesh.contact_size=1", "-ehl_memory_per_rank", "-2"],
+        3,
+        &["-ehl_memory_per_rank = -2", "a positive number of GB"],
+    ));
     v
 }
 

@@ -26,13 +26,14 @@
 //!    the limit, not convergence (see
 //!    `estimate::estimate_scaled`). Stop when every estimate is below the target (from level 2 on, so
 //!    that rho is measured).
-//! 5. A next level above `accuracy.max_unknowns` refines only the marked triangles of
-//!    largest indicator that fit (`marking::cut_count`), once per run; its
+//! 5. A next level above `accuracy.max_unknowns` (or the unknowns the time left or the
+//!    memory a rank may reach holds: `marking::TimeLeft`, `memory::MemoryLeft`) refines
+//!    only the marked triangles of largest indicator that fit (`marking::cut_count`), once per run; its
 //!    estimate is the one before it less its change (`estimate_after_cut`), unless it
 //!    keeps 90 % of the marked indicator: then it is estimated and gated as a full level
 //!    (`Estimate::cut_worth_solving`).
 //! 6. When the target cannot be reached (`accuracy.max_levels` levels solved, the next
-//!    level above `accuracy.max_unknowns` with too little room for a cut, or every
+//!    level above a budget with too little room for a cut, or every
 //!    triangle at the smallest size), the
 //!    last level's result is written with its estimated error, `accuracy.reached` is
 //!    false and the run exits 4: a result, honestly labelled, rather than none.
@@ -49,6 +50,7 @@ use super::marking::{
     cut_count, goal_mark, goals, longest_edges, next_field, quarters, widened_count, zone_mark, Marking, NextMesh, TimeLeft,
     MIN_BUDGET_SHARE,
 };
+use super::memory::{self, MemoryLeft};
 use super::{Context, Outcome};
 use crate::case::schema::RAISED_GRADIENT_JUMP;
 use crate::case::{CavitationModel, Scene};
@@ -142,6 +144,9 @@ pub struct Level {
     /// How many triangles the level's marking refines for the next level (after any
     /// widening; None before it marks, or without a marking).
     pub marked: Option<usize>,
+    /// The peak resident memory of a rank so far, the largest of the ranks (MB), read once
+    /// the level converged: the level's own where levels grow.
+    pub peak_memory_mb: f64,
 }
 
 impl Level {
@@ -213,20 +218,23 @@ impl<'a> PlannedCut<'a> {
     }
 }
 
-/// The budget a level is cut to: `accuracy.max_unknowns`, or the unknowns the time left of
-/// `accuracy.max_seconds` allows.
+/// The budget a level is cut to: `accuracy.max_unknowns`, the unknowns the time left of
+/// `accuracy.max_seconds` allows, or those the memory a rank may reach holds
+/// ([`super::memory`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Budget {
     Unknowns,
     Seconds,
+    Memory,
 }
 
 impl Budget {
-    /// The scene key that sets it.
+    /// The scene key or option that sets it.
     pub fn key(self) -> &'static str {
         match self {
             Budget::Unknowns => "accuracy.max_unknowns",
             Budget::Seconds => "accuracy.max_seconds",
+            Budget::Memory => "-ehl_memory_per_rank",
         }
     }
 }
@@ -344,6 +352,11 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let time = time_left(ctx, acc, &levels, previous.as_ref());
         let by_time = time.filter(|t| t.unknowns() < acc.max_unknowns);
         let budget = by_time.map_or(acc.max_unknowns, |t| t.unknowns());
+        // The memory as a bound too: a level the node cannot hold is cut or not begun,
+        // rather than killed with the run.
+        let by_memory = memory_left(ctx, &levels, previous.as_ref()).filter(|m| m.unknowns() < budget);
+        let by_time = by_time.filter(|_| by_memory.is_none());
+        let budget = by_memory.map_or(budget, |m| m.unknowns());
         // Quartering saves a level; over a budget the level it would save is not reached
         // anyway, and halving leaves room for the rest of the marking
         // (cases/hard/spin-0.5deg: quartered, level 4 would have had 998,894 unknowns).
@@ -363,8 +376,21 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             // fit, once per run (a cut level is the last, below), and not when even the next
             // full level's change could not take every estimate below the target.
             let before = levels.last().map_or(0, |l| l.unknowns() as u64);
-            let over_what = match by_time {
-                Some(t) => format!(
+            let over_what = match (by_memory, by_time) {
+                (Some(m), _) => format!(
+                    "level {k} would have {n} unknowns and need about {:.1} GB per rank from level {}'s peak ({:.1} GB at {} unknowns), more than {:.0} % of the {:.1} GB a rank may reach ({})",
+                    m.predicted(n) / 1024.0,
+                    k - 1,
+                    m.peak_mb / 1024.0,
+                    m.before,
+                    100.0 * super::memory::MEMORY_FILL,
+                    m.room_mb / 1024.0,
+                    match crate::ehl_options::get().memory_per_rank_gb {
+                        Some(_) => "-ehl_memory_per_rank".to_string(),
+                        None => "its memory now and its share of the node's free memory; -ehl_memory_per_rank sets it".to_string(),
+                    }
+                ),
+                (None, Some(t)) => format!(
                     "level {k} would have {n} unknowns and take about {:.0} s at level {}'s cost ({} unknowns in {:.0} s), more than the {:.0} s left of accuracy.max_seconds = {} s",
                     t.predicted(n),
                     k - 1,
@@ -373,12 +399,16 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                     t.left.max(0.0),
                     acc.max_seconds
                 ),
-                None => format!("level {k} would have {n} unknowns, above accuracy.max_unknowns = {}", acc.max_unknowns),
+                (None, None) => format!("level {k} would have {n} unknowns, above accuracy.max_unknowns = {}", acc.max_unknowns),
             };
             // The cut this mesh leads to (none without a ranked marking, or after
             // [`MAX_CUTS`] meshes).
-            let planned =
-                prev.marking.as_ref().filter(|_| over.len() < MAX_CUTS).and_then(|m| PlannedCut::of(m, &over, cut, n, before, budget));
+            let planned = prev
+                .marking
+                .as_ref()
+                .filter(|_| over.len() < MAX_CUTS)
+                .and_then(|m| PlannedCut::of(m, &over, cut, n, before, budget))
+                .filter(|p| p.count > 0);
             let hopeful = planned.as_ref().is_some_and(|p| {
                 Estimate::cut_worth_solving(&levels, target, scene.effects.cavitation == CavitationModel::Penalty, p.share)
             });
@@ -413,7 +443,12 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         100.0 * share
                     ));
                     next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), marking, Some(count), growth));
-                    cut = Some(Cut { count, share, by: if by_time.is_some() { Budget::Seconds } else { Budget::Unknowns } });
+                    let by = match (by_memory, by_time) {
+                        (Some(_), _) => Budget::Memory,
+                        (None, Some(_)) => Budget::Seconds,
+                        (None, None) => Budget::Unknowns,
+                    };
+                    cut = Some(Cut { count, share, by });
                     continue;
                 }
             }
@@ -720,6 +755,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             penalty: None,
             again: std::mem::take(&mut again),
             marked: None,
+            peak_memory_mb: collective::max_f64(&ctx.world, crate::output::peak_rss_mb()),
         };
         over.clear();
         levels.push(level);
@@ -854,6 +890,9 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         "level {k} was cut to the time left of accuracy.max_seconds = {} s: the level after it would not end in it",
                         acc.max_seconds
                     )
+                }
+                Some(Budget::Memory) => {
+                    format!("level {k} was cut to the memory a rank may reach: the level after it would need more")
                 }
                 _ => format!("level {k} was cut to accuracy.max_unknowns = {}: the level after it would exceed it", acc.max_unknowns),
             };
@@ -1175,6 +1214,30 @@ fn time_left(ctx: &Context, acc: crate::case::schema::Accuracy, levels: &[Level]
     Some(TimeLeft { left: acc.max_seconds - t[0], before: last.unknowns() as u64, seconds: t[1] })
 }
 
+/// The memory as it bears on the next level: the rank whose room holds the fewest unknowns
+/// ([`MemoryLeft`]), from the last level's peak, grown as the last level's coupling grows.
+/// Collective: every rank gets the same bound.
+fn memory_left(ctx: &Context, levels: &[Level], previous: Option<&Solved>) -> Option<MemoryLeft> {
+    let exponent = match previous?.condensation_s {
+        Some(_) => memory::CONDENSED_MEMORY_EXPONENT,
+        None => memory::LEVEL_MEMORY_EXPONENT,
+    };
+    let before = levels.last()?.unknowns() as u64;
+    let room = match crate::ehl_options::get().memory_per_rank_gb {
+        Some(gb) => gb * 1024.0,
+        None => {
+            use mpi::traits::Communicator;
+            let here = ctx.world.split_shared(0).size().max(1) as f64;
+            match (memory::resident_mb(), memory::node_free_mb()) {
+                (Some(r), Some(f)) => r + f / here,
+                _ => f64::INFINITY,
+            }
+        }
+    };
+    let all = collective::all_gather_f64(&ctx.world, &[room, crate::output::peak_rss_mb()]);
+    all.chunks(2).map(|c| MemoryLeft { room_mb: c[0], before, peak_mb: c[1], exponent }).min_by_key(|m| m.unknowns())
+}
+
 /// After level `k` stopped with `e`: when the time budget was spent (and a level converged
 /// before), the last converged level's result, labelled as short of its target; any other
 /// error (a signal, a failure outside Newton) stops the run.
@@ -1264,6 +1327,7 @@ fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> se
                 "contact_triangles": l.contact_triangles, "smallest_size_a": l.min_size,
                 "newton_iterations": l.newton_iterations, "seconds": l.seconds, "failed_attempts_seconds": l.failed_seconds,
                 "halvings": l.halvings, "hc_m": l.hc, "hm_m": l.hm, "hm_at_a": l.hm_at, "pmax_pa": l.pmax,
+                "peak_memory_per_rank_mb": l.peak_memory_mb,
             });
             // The first level has no estimate: the key is left out (summary.json holds no null).
             if let Some(e) = l.est {
@@ -1326,6 +1390,7 @@ mod tests {
             penalty: None,
             again: false,
             marked: Some(7),
+            peak_memory_mb: 0.0,
         };
         // M = 100, L = 20: 7 of level 1's 965 triangles marked, 1,201 on level 2.
         assert!(!certifies(&[level(720), level(965), level(1201)]));

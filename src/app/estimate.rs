@@ -527,6 +527,7 @@ mod tests {
             penalty: None,
             again: false,
             marked: None,
+            peak_memory_mb: 0.0,
         }
     }
 

@@ -8,6 +8,7 @@ mod face_files;
 mod first_level;
 pub mod lubricated;
 mod marking;
+mod memory;
 pub mod plots;
 pub mod restart;
 mod sensitivity;

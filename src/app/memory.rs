@@ -1,0 +1,155 @@
+//! The memory a level of an adaptive run may use ([`super::adapt`], step 5).
+//!
+//! A level the machine cannot hold is killed by the kernel, and every rank with it: the run
+//! ends with no result after its most expensive level. Predicted instead, the level is cut
+//! to what fits or not begun, and the run ends with the last level's result and its
+//! estimated error (exit 4), as at the unknowns budget.
+//!
+//! The prediction: the next level's peak resident memory per rank from the last level's
+//! (the rank's peak so far), grown with the unknowns at [`LEVEL_MEMORY_EXPONENT`]
+//! ([`CONDENSED_MEMORY_EXPONENT`] after a condensed level). What a
+//! rank may reach: `-ehl_memory_per_rank`, or else its present resident memory plus its
+//! share of what the node has free (`MemAvailable`, or less where a cgroup v2 limit leaves
+//! less), shared among the run's ranks on the node. On a node with room for the scene's
+//! unknowns budget the memory never binds, and a scene's levels do not depend on the
+//! machine.
+
+/// Exponent of a monolithic level's peak memory in its unknowns (block low-rank LU, 2
+/// ranks): between consecutive adaptive levels it was 1.05-1.11 on table2-ue2 (156,208 ->
+/// 501,986 -> 738,218 unknowns: 1.2, 4.1, 6.3 GB per rank) and 1.24 on
+/// cases/hard/heavy-3gpa (597,932 -> 1,081,612: 4.5, 9.4 GB). The largest, rounded up: a
+/// prediction too high cuts a level that would have fitted, one too low loses the run.
+pub const LEVEL_MEMORY_EXPONENT: f64 = 1.3;
+
+/// The same after a level solved with the condensed coupling, whose dense Schur complement
+/// grows with the square of the face's unknowns (the adaptive loop condenses only levels
+/// of fewer than 4,000 pressure unknowns, where the square is far from any room; a scene
+/// that sets `reynolds.coupling = "condensed"` keeps it: cases/paper/case2's 0.03125 a ring
+/// took 10.9 GB per rank on 2 ranks with 14,513 pressure unknowns, docs/performance.md).
+pub const CONDENSED_MEMORY_EXPONENT: f64 = 2.0;
+
+/// The share of a rank's room a level is planned to fill: the rest is for what the
+/// prediction does not see (MUMPS's workspace grown after delayed pivots, the page cache
+/// other processes need).
+pub const MEMORY_FILL: f64 = 0.9;
+
+/// A rank's room for the next level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MemoryLeft {
+    /// The resident memory the rank may reach (MB).
+    pub room_mb: f64,
+    /// The last level's unknowns.
+    pub before: u64,
+    /// The rank's peak resident memory so far, the last level's (MB).
+    pub peak_mb: f64,
+    /// How the peak grows with the unknowns ([`LEVEL_MEMORY_EXPONENT`],
+    /// [`CONDENSED_MEMORY_EXPONENT`]).
+    pub exponent: f64,
+}
+
+impl MemoryLeft {
+    /// The peak resident memory a level of `n` unknowns is expected to reach (MB).
+    pub fn predicted(&self, n: u64) -> f64 {
+        self.peak_mb * (n as f64 / self.before.max(1) as f64).powf(self.exponent)
+    }
+
+    /// The most unknowns a level may have and be expected to fit [`MEMORY_FILL`] of the
+    /// room.
+    pub fn unknowns(&self) -> u64 {
+        if !(self.peak_mb > 0.0) || self.room_mb.is_infinite() {
+            return u64::MAX;
+        }
+        let n = self.before as f64 * (MEMORY_FILL * self.room_mb.max(0.0) / self.peak_mb).powf(1.0 / self.exponent);
+        n.min(u64::MAX as f64) as u64
+    }
+}
+
+/// `MemAvailable` of /proc/meminfo's text (MB): memory the kernel can give without
+/// swapping (free pages and reclaimable caches).
+fn mem_available_mb(meminfo: &str) -> Option<f64> {
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+/// The room under a cgroup v2 memory limit (MB): `memory.max` less `memory.current`, None
+/// without a limit (`max`).
+fn cgroup_room_mb(max: &str, current: &str) -> Option<f64> {
+    let max: f64 = max.trim().parse().ok()?;
+    let current: f64 = current.trim().parse().ok()?;
+    Some((max - current).max(0.0) / (1024.0 * 1024.0))
+}
+
+/// What the node has free for this process's group (MB): `MemAvailable`, or the room under
+/// the cgroup's limit where that is less. None where neither can be read.
+pub fn node_free_mb() -> Option<f64> {
+    let read = |p: &str| std::fs::read_to_string(p).ok();
+    let available = read("/proc/meminfo").and_then(|s| mem_available_mb(&s));
+    let cgroup = match (read("/sys/fs/cgroup/memory.max"), read("/sys/fs/cgroup/memory.current")) {
+        (Some(m), Some(c)) => cgroup_room_mb(&m, &c),
+        _ => None,
+    };
+    match (available, cgroup) {
+        (Some(a), Some(c)) => Some(a.min(c)),
+        (a, c) => a.or(c),
+    }
+}
+
+/// This process's present resident memory (MB), from /proc/self/statm.
+pub fn resident_mb() -> Option<f64> {
+    let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
+    let pages: f64 = statm.split_whitespace().nth(1)?.parse().ok()?;
+    let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
+    (page > 0).then(|| pages * page as f64 / (1024.0 * 1024.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_prediction_holds_the_measured_levels_and_what_fits_is_what_it_allows() {
+        // cases/hard/heavy-3gpa, 2 ranks: level 4 597,932 unknowns at 4.5 GB per rank,
+        // level 5 1,081,612 at 9.4 GB. The prediction lies above, within 10 %.
+        let m = MemoryLeft { room_mb: 12_000.0, before: 597_932, peak_mb: 4_500.0, exponent: LEVEL_MEMORY_EXPONENT };
+        let p = m.predicted(1_081_612);
+        assert!(p > 9_400.0 && p < 1.1 * 9_400.0, "predicted {p} MB");
+        // table2-ue2 at target 0.001, levels of 501,986 and 738,218 unknowns (4.1, 6.3 GB).
+        let t = MemoryLeft { room_mb: 12_000.0, before: 501_986, peak_mb: 4_100.0, exponent: LEVEL_MEMORY_EXPONENT }.predicted(738_218);
+        assert!(t > 6_300.0 && t < 1.1 * 6_300.0, "predicted {t} MB");
+        // The unknowns that fit are predicted at the fill, and a few more are not.
+        let n = m.unknowns();
+        assert!(m.predicted(n) <= MEMORY_FILL * m.room_mb * (1.0 + 1e-9));
+        assert!(m.predicted(n + 100) > MEMORY_FILL * m.room_mb);
+        // 12 GB per rank hold level 5 (the 0.9 of it, 10.8 GB, above the predicted 9.9).
+        assert!(n > 1_081_612);
+        // 8 GB do not.
+        assert!(MemoryLeft { room_mb: 8_000.0, ..m }.unknowns() < 1_081_612);
+        // No room: nothing fits; no measure: nothing binds.
+        assert_eq!(MemoryLeft { room_mb: 0.0, ..m }.unknowns(), 0);
+        assert_eq!(MemoryLeft { room_mb: f64::INFINITY, ..m }.unknowns(), u64::MAX);
+        assert_eq!(MemoryLeft { peak_mb: 0.0, ..m }.unknowns(), u64::MAX);
+        // After a condensed level the square: twice the unknowns, four times the memory.
+        let c = MemoryLeft { exponent: CONDENSED_MEMORY_EXPONENT, ..m };
+        assert!((c.predicted(2 * 597_932) / (4.0 * 4_500.0) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn free_memory_is_read_from_meminfo_and_a_cgroup_limit() {
+        let meminfo = "MemTotal:       24683656 kB\nMemFree:         1000000 kB\nMemAvailable:   24148796 kB\n";
+        assert!((mem_available_mb(meminfo).unwrap() - 24148796.0 / 1024.0).abs() < 1e-9);
+        assert_eq!(mem_available_mb("MemTotal: 1 kB\n"), None);
+        // 8 GiB limit, 2 GiB used: 6 GiB of room.
+        assert_eq!(cgroup_room_mb("8589934592\n", "2147483648\n"), Some(6144.0));
+        assert_eq!(cgroup_room_mb("max\n", "2147483648\n"), None);
+        // Over the limit (reclaim pending): no room, not a negative one.
+        assert_eq!(cgroup_room_mb("1048576", "2097152"), Some(0.0));
+    }
+
+    #[test]
+    fn this_process_has_a_resident_memory_and_the_node_some_free() {
+        let r = resident_mb().expect("/proc/self/statm");
+        assert!(r > 0.0 && r < 1e6, "{r} MB");
+        assert!(node_free_mb().is_some_and(|f| f >= 0.0));
+    }
+}
