@@ -15,11 +15,14 @@
 //! machine.
 
 /// Exponent of a monolithic level's peak memory in its unknowns (block low-rank LU, 2
-/// ranks): between consecutive adaptive levels it was 1.05-1.11 on table2-ue2 (156,208 ->
-/// 501,986 -> 738,218 unknowns: 1.2, 4.1, 6.3 GB per rank) and 1.24 on
-/// cases/hard/heavy-3gpa (597,932 -> 1,081,612: 4.5, 9.4 GB). The largest, rounded up: a
-/// prediction too high cuts a level that would have fitted, one too low loses the run.
-pub const LEVEL_MEMORY_EXPONENT: f64 = 1.3;
+/// ranks). Between consecutive adaptive levels of cases/hard/heavy-3gpa (137,155 to
+/// 1,081,612 unknowns; peaks 1.1, 1.3, 2.2, 3.0, 4.9 and 9.0 GB per rank) it was 0.7-1.7,
+/// and 1.09 and 1.01 over the two largest steps; on table2-ue2 1.05-1.11 (156,208 ->
+/// 501,986 -> 738,218 unknowns: 1.2, 4.1, 6.3 GB). A prediction too high cuts a level that
+/// would have fitted (heavy-3gpa's level 5, 18 GB on a node of 24 GB: at 1.3 its budget
+/// was within 1.5 % of it), one too low loses the run; [`MEMORY_FILL`] holds the steps
+/// above 1.2 at the small sizes where they were seen.
+pub const LEVEL_MEMORY_EXPONENT: f64 = 1.2;
 
 /// The same after a level solved with the condensed coupling, whose dense Schur complement
 /// grows with the square of the face's unknowns (the adaptive loop condenses only levels
@@ -109,11 +112,11 @@ mod tests {
 
     #[test]
     fn the_prediction_holds_the_measured_levels_and_what_fits_is_what_it_allows() {
-        // cases/hard/heavy-3gpa, 2 ranks: level 4 597,932 unknowns at 4.5 GB per rank,
-        // level 5 1,081,612 at 9.4 GB. The prediction lies above, within 10 %.
-        let m = MemoryLeft { room_mb: 12_000.0, before: 597_932, peak_mb: 4_500.0, exponent: LEVEL_MEMORY_EXPONENT };
+        // cases/hard/heavy-3gpa, 2 ranks: level 4 597,932 unknowns at 4,938 MB per rank,
+        // level 5 1,081,612 at 8,991 MB. The prediction lies above, within 15 %.
+        let m = MemoryLeft { room_mb: 12_000.0, before: 597_932, peak_mb: 4_938.0, exponent: LEVEL_MEMORY_EXPONENT };
         let p = m.predicted(1_081_612);
-        assert!(p > 9_400.0 && p < 1.1 * 9_400.0, "predicted {p} MB");
+        assert!(p > 8_991.0 && p < 1.15 * 8_991.0, "predicted {p} MB");
         // table2-ue2 at target 0.001, levels of 501,986 and 738,218 unknowns (4.1, 6.3 GB).
         let t = MemoryLeft { room_mb: 12_000.0, before: 501_986, peak_mb: 4_100.0, exponent: LEVEL_MEMORY_EXPONENT }.predicted(738_218);
         assert!(t > 6_300.0 && t < 1.1 * 6_300.0, "predicted {t} MB");
@@ -121,7 +124,7 @@ mod tests {
         let n = m.unknowns();
         assert!(m.predicted(n) <= MEMORY_FILL * m.room_mb * (1.0 + 1e-9));
         assert!(m.predicted(n + 100) > MEMORY_FILL * m.room_mb);
-        // 12 GB per rank hold level 5 (the 0.9 of it, 10.8 GB, above the predicted 9.9).
+        // 12 GB per rank hold level 5 (the 0.9 of it, 10.8 GB, above the predicted 10.1).
         assert!(n > 1_081_612);
         // 8 GB do not.
         assert!(MemoryLeft { room_mb: 8_000.0, ..m }.unknowns() < 1_081_612);
@@ -131,7 +134,7 @@ mod tests {
         assert_eq!(MemoryLeft { peak_mb: 0.0, ..m }.unknowns(), u64::MAX);
         // After a condensed level the square: twice the unknowns, four times the memory.
         let c = MemoryLeft { exponent: CONDENSED_MEMORY_EXPONENT, ..m };
-        assert!((c.predicted(2 * 597_932) / (4.0 * 4_500.0) - 1.0).abs() < 1e-12);
+        assert!((c.predicted(2 * 597_932) / (4.0 * 4_938.0) - 1.0).abs() < 1e-12);
     }
 
     #[test]
