@@ -17,7 +17,7 @@
 /// Exponent of a monolithic level's peak memory in its unknowns (block low-rank LU, 2
 /// ranks). Between consecutive adaptive levels of cases/hard/heavy-3gpa (137,155 to
 /// 1,081,612 unknowns; peaks 1.1, 1.3, 2.2, 3.0, 4.9 and 9.0 GB per rank) it was 0.7-1.7,
-/// and 1.09 and 1.01 over the two largest steps; on table2-ue2 1.05-1.11 (156,208 ->
+/// and 1.09 and 1.01 over the two largest steps (predicted 5 % and 12 % high); on table2-ue2 1.05-1.11 (156,208 ->
 /// 501,986 -> 738,218 unknowns: 1.2, 4.1, 6.3 GB). A prediction too high cuts a level that
 /// would have fitted (heavy-3gpa's level 5, 18 GB on a node of 24 GB: at 1.3 its budget
 /// was within 1.5 % of it), one too low loses the run; [`MEMORY_FILL`] holds the steps
