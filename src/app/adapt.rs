@@ -357,6 +357,11 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let by_memory = memory_left(ctx, &levels, previous.as_ref()).filter(|m| m.unknowns() < budget);
         let by_time = by_time.filter(|_| by_memory.is_none());
         let budget = by_memory.map_or(budget, |m| m.unknowns());
+        let budget_by = match (by_memory, by_time) {
+            (Some(_), _) => Budget::Memory,
+            (None, Some(_)) => Budget::Seconds,
+            (None, None) => Budget::Unknowns,
+        };
         // Quartering saves a level; over a budget the level it would save is not reached
         // anyway, and halving leaves room for the rest of the marking
         // (cases/hard/spin-0.5deg: quartered, level 4 would have had 998,894 unknowns).
@@ -365,7 +370,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let over_budget = n > budget && !again;
         if let Some(prev) = previous.as_mut().filter(|p| over_budget && p.marking.as_ref().is_some_and(|m| m.quartered() > 0)) {
             ctx.log(format!(
-                "accuracy: level {k} would have {n} unknowns, above its budget of {budget}; again with its {} quartered triangles halved",
+                "accuracy: level {k} would have {n} unknowns, above its budget of {budget} ({}); again with its {} quartered triangles halved",
+                budget_by.key(),
                 prev.marking.as_ref().map_or(0, |m| m.quartered())
             ));
             next = prev.halved_marking(growth);
@@ -443,12 +449,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                         100.0 * share
                     ));
                     next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), marking, Some(count), growth));
-                    let by = match (by_memory, by_time) {
-                        (Some(_), _) => Budget::Memory,
-                        (None, Some(_)) => Budget::Seconds,
-                        (None, None) => Budget::Unknowns,
-                    };
-                    cut = Some(Cut { count, share, by });
+                    cut = Some(Cut { count, share, by: budget_by });
                     continue;
                 }
             }
