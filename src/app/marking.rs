@@ -324,12 +324,18 @@ pub(super) fn goal_mark(
     let total: f64 = parts.iter().map(|(_, s)| s).sum();
     let places = goals.iter().filter(|g| g.name == "hm").count();
     ctx.log(format!(
-        "accuracy: goal-oriented marking (the weighted indicator: {}{}): {} of {} contact triangles marked ({} of them quartered; fraction {theta} of the weighted indicator{}), {:.1} s",
+        "accuracy: goal-oriented marking (the weighted indicator: {}{}): {} of {} contact triangles marked ({} of them quartered{}; fraction {theta} of the weighted indicator{}), {:.1} s",
         parts.iter().map(|(name, s)| format!("{name} {:.0} %", 100.0 * s / total)).collect::<Vec<_>>().join(", "),
         if places > 1 { format!("; hm at {places} places") } else { String::new() },
         marking.marked.iter().filter(|&&m| m).count(),
         marking.marked.len(),
         marking.quartered(),
+        // The quartered triangles' share of the marked indicator, which says how much of
+        // the level the crossing guard's two halvings stand for (docs/accuracy.md, Open).
+        match marking.quartered() {
+            0 => String::new(),
+            q => format!(", {:.0} % of the marked indicator", 100.0 * marking.indicator_share(q)),
+        },
         if jumps.is_empty() {
             String::new()
         } else {
