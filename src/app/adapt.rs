@@ -354,7 +354,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         let budget = by_time.map_or(acc.max_unknowns, |t| t.unknowns());
         // The memory as a bound too: a level the node cannot hold is cut or not begun,
         // rather than killed with the run.
-        let by_memory = memory_left(ctx, &levels, previous.as_ref()).filter(|m| m.unknowns() < budget);
+        let condensed = Coupling::of_scene(scene, n_p, previous.is_some()) == Coupling::Condensed;
+        let by_memory = memory_left(ctx, &levels, previous.as_ref(), condensed).filter(|m| m.unknowns() < budget);
         let by_time = by_time.filter(|_| by_memory.is_none());
         let budget = by_memory.map_or(budget, |m| m.unknowns());
         let budget_by = match (by_memory, by_time) {
@@ -1216,13 +1217,11 @@ fn time_left(ctx: &Context, acc: crate::case::schema::Accuracy, levels: &[Level]
 }
 
 /// The memory as it bears on the next level: the rank whose room holds the fewest unknowns
-/// ([`MemoryLeft`]), from the last level's peak, grown as the last level's coupling grows.
-/// Collective: every rank gets the same bound.
-fn memory_left(ctx: &Context, levels: &[Level], previous: Option<&Solved>) -> Option<MemoryLeft> {
-    let exponent = match previous?.condensation_s {
-        Some(_) => memory::CONDENSED_MEMORY_EXPONENT,
-        None => memory::LEVEL_MEMORY_EXPONENT,
-    };
+/// ([`MemoryLeft`]), from the last level's peak (after the first level), grown as the next
+/// level's coupling grows (`condensed`). Collective: every rank gets the same bound.
+fn memory_left(ctx: &Context, levels: &[Level], previous: Option<&Solved>, condensed: bool) -> Option<MemoryLeft> {
+    previous?;
+    let exponent = if condensed { memory::CONDENSED_MEMORY_EXPONENT } else { memory::LEVEL_MEMORY_EXPONENT };
     let before = levels.last()?.unknowns() as u64;
     let room = match crate::ehl_options::get().memory_per_rank_gb {
         Some(gb) => gb * 1024.0,

@@ -7,7 +7,7 @@
 //!
 //! The prediction: the next level's peak resident memory per rank from the last level's
 //! (the rank's peak so far), grown with the unknowns at [`LEVEL_MEMORY_EXPONENT`]
-//! ([`CONDENSED_MEMORY_EXPONENT`] after a condensed level). What a
+//! ([`CONDENSED_MEMORY_EXPONENT`] for a level that will be condensed). What a
 //! rank may reach: `-ehl_memory_per_rank`, or else its present resident memory plus its
 //! share of what the node has free (`MemAvailable`, or less where a cgroup v2 limit leaves
 //! less), shared among the run's ranks on the node. On a node with room for the scene's
@@ -24,7 +24,7 @@
 /// above 1.2 at the small sizes where they were seen.
 pub const LEVEL_MEMORY_EXPONENT: f64 = 1.2;
 
-/// The same after a level solved with the condensed coupling, whose dense Schur complement
+/// The same for a level solved with the condensed coupling, whose dense Schur complement
 /// grows with the square of the face's unknowns (the adaptive loop condenses only levels
 /// of fewer than 4,000 pressure unknowns, where the square is far from any room; a scene
 /// that sets `reynolds.coupling = "condensed"` keeps it: cases/paper/case2's 0.03125 a ring
