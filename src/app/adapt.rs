@@ -144,8 +144,8 @@ pub struct Level {
     /// How many triangles the level's marking refines for the next level (after any
     /// widening; None before it marks, or without a marking).
     pub marked: Option<usize>,
-    /// The peak resident memory of a rank so far, the largest of the ranks (MB), read once
-    /// the level converged: the level's own where levels grow.
+    /// The level's peak resident memory per rank, the largest of the ranks (MB), from the
+    /// start of its last attempt to its friction pass (`output::restart_peak`).
     pub peak_memory_mb: f64,
 }
 
@@ -472,6 +472,8 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // ones (M = 500, L = 15's level 2, 2,684 pressure unknowns: 16.2 s condensed, 36
         // iterations; 22.9 s monolithic, 42).
         let sequenced = (previous.is_some() && plain) || earlier.is_some();
+        // The level's own peak memory, for its report and the next level's prediction.
+        crate::output::restart_peak();
         let mut solver = match EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half, sequenced) {
             Ok(s) => s,
             Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
@@ -757,7 +759,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             penalty: None,
             again: std::mem::take(&mut again),
             marked: None,
-            peak_memory_mb: collective::max_f64(&ctx.world, crate::output::peak_rss_mb()),
+            peak_memory_mb: collective::max_f64(&ctx.world, crate::output::peak_since_mb()),
         };
         over.clear();
         levels.push(level);
@@ -1217,7 +1219,7 @@ fn time_left(ctx: &Context, acc: crate::case::schema::Accuracy, levels: &[Level]
 }
 
 /// The memory as it bears on the next level: the rank whose room holds the fewest unknowns
-/// ([`MemoryLeft`]), from the last level's peak (after the first level), grown as the next
+/// ([`MemoryLeft`]), from the last level's own peak (the largest rank's), grown as the next
 /// level's coupling grows (`condensed`). Collective: every rank gets the same bound.
 fn memory_left(ctx: &Context, levels: &[Level], previous: Option<&Solved>, condensed: bool) -> Option<MemoryLeft> {
     previous?;
@@ -1234,8 +1236,9 @@ fn memory_left(ctx: &Context, levels: &[Level], previous: Option<&Solved>, conde
             }
         }
     };
-    let all = collective::all_gather_f64(&ctx.world, &[room, crate::output::peak_rss_mb()]);
-    all.chunks(2).map(|c| MemoryLeft { room_mb: c[0], before, peak_mb: c[1], exponent }).min_by_key(|m| m.unknowns())
+    let peak_mb = levels.last()?.peak_memory_mb;
+    let rooms = collective::all_gather_f64(&ctx.world, &[room]);
+    rooms.iter().map(|&room_mb| MemoryLeft { room_mb, before, peak_mb, exponent }).min_by_key(|m| m.unknowns())
 }
 
 /// After level `k` stopped with `e`: when the time budget was spent (and a level converged

@@ -6,7 +6,8 @@
 //! estimated error (exit 4), as at the unknowns budget.
 //!
 //! The prediction: the next level's peak resident memory per rank from the last level's
-//! (the rank's peak so far), grown with the unknowns at [`LEVEL_MEMORY_EXPONENT`]
+//! own (the largest rank's, from the kernel's high-water mark restarted at each level),
+//! grown with the unknowns at [`LEVEL_MEMORY_EXPONENT`]
 //! ([`CONDENSED_MEMORY_EXPONENT`] for a level that will be condensed). What a
 //! rank may reach: `-ehl_memory_per_rank`, or else its present resident memory plus its
 //! share of what the node has free (`MemAvailable`, or less where a cgroup v2 limit leaves
@@ -43,7 +44,7 @@ pub struct MemoryLeft {
     pub room_mb: f64,
     /// The last level's unknowns.
     pub before: u64,
-    /// The rank's peak resident memory so far, the last level's (MB).
+    /// The last level's peak resident memory per rank (MB).
     pub peak_mb: f64,
     /// How the peak grows with the unknowns ([`LEVEL_MEMORY_EXPONENT`],
     /// [`CONDENSED_MEMORY_EXPONENT`]).

@@ -178,19 +178,66 @@ pub fn publish(staging: &Path, dir: &Path) -> Result<(), Error> {
     std::fs::remove_dir(staging).map_err(err)
 }
 
-/// Peak resident memory of this process in MiB (getrusage ru_maxrss).
+/// The process's peak before the last [`restart_peak`] (kB): the kernel's mark that
+/// getrusage reads starts again there.
+static EARLIER_PEAK_KB: std::sync::atomic::AtomicI64 = std::sync::atomic::AtomicI64::new(0);
+
+/// Peak resident memory of this process in MiB (getrusage ru_maxrss, and the peaks before
+/// any [`restart_peak`]).
 pub fn peak_rss_mb() -> f64 {
     let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
     if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } == 0 {
-        usage.ru_maxrss as f64 / 1024.0
+        let earlier = EARLIER_PEAK_KB.load(std::sync::atomic::Ordering::Relaxed);
+        usage.ru_maxrss.max(earlier) as f64 / 1024.0
     } else {
         f64::NAN
     }
 }
 
+/// Starts a new peak (Linux 4.0 and later: "5" to /proc/self/clear_refs resets the
+/// high-water mark of the resident memory, and nothing else), so that [`peak_since_mb`]
+/// gives the peak of what follows; [`peak_rss_mb`] keeps the process's. Without it the
+/// peak since is the process's.
+pub fn restart_peak() {
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } == 0 {
+        EARLIER_PEAK_KB.fetch_max(usage.ru_maxrss, std::sync::atomic::Ordering::Relaxed);
+        let _ = std::fs::write("/proc/self/clear_refs", "5");
+    }
+}
+
+/// Peak resident memory since the last [`restart_peak`] (MiB; `VmHWM` of /proc/self/status),
+/// or the process's where that cannot be read.
+pub fn peak_since_mb() -> f64 {
+    let hwm = std::fs::read_to_string("/proc/self/status").ok().and_then(|s| {
+        let line = s.lines().find(|l| l.starts_with("VmHWM:"))?.to_string();
+        line.split_whitespace().nth(1)?.parse::<f64>().ok()
+    });
+    hwm.map_or_else(peak_rss_mb, |kb| kb / 1024.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_restarted_peak_counts_what_follows_and_the_process_keeps_its_own() {
+        // 64 MB touched and freed before the restart raise the process's peak, not the new one.
+        let before = {
+            let v = vec![1u8; 64 << 20];
+            std::hint::black_box(&v);
+            peak_rss_mb()
+        };
+        restart_peak();
+        let since = peak_since_mb();
+        assert!(peak_rss_mb() >= before, "{} < {before}", peak_rss_mb());
+        assert!(since <= peak_rss_mb(), "{since} > {}", peak_rss_mb());
+        // 32 MB touched after it are in the new peak.
+        let v = vec![1u8; 32 << 20];
+        std::hint::black_box(&v);
+        assert!(peak_since_mb() >= since, "{} < {since}", peak_since_mb());
+        assert!(peak_since_mb() > 30.0, "{}", peak_since_mb());
+    }
 
     #[test]
     fn a_stale_lock_is_taken_over_with_the_dead_runs_leftovers_and_nothing_else() {
