@@ -7,12 +7,17 @@ use common::*;
 /// more `--set KEY=VALUE`, in `scratch(name)/run`; returns the run and its summary (Null
 /// when none was written).
 fn moes_m10(name: &str, set: &[&str]) -> (std::process::Output, serde_json::Value) {
+    moes_m10_with(name, set, &[])
+}
+
+/// [`moes_m10`] with PETSc-style options `petsc` after the scene's settings.
+fn moes_m10_with(name: &str, set: &[&str], petsc: &[&str]) -> (std::process::Output, serde_json::Value) {
     let dir = scratch(name);
     let scene = repo().join("cases/references/moes-m10-l6.toml");
     let run = dir.join("run");
     let args =
         [scene.to_str().unwrap(), "--output", run.to_str().unwrap(), "--set", "accuracy.target=0.05", "--set", "mesh.contact_size=0.5"];
-    let args: Vec<&str> = args.into_iter().chain(set.iter().flat_map(|s| ["--set", s])).collect();
+    let args: Vec<&str> = args.into_iter().chain(set.iter().flat_map(|s| ["--set", s])).chain(petsc.iter().copied()).collect();
     let out = mpirun(2, &args);
     let summary = std::fs::read_to_string(run.join("summary.json")).map_or(serde_json::Value::Null, |t| serde_json::from_str(&t).unwrap());
     (out, summary)
@@ -378,25 +383,10 @@ fn a_level_over_the_budget_refines_the_share_of_its_marking_that_fits() {
 /// reports the peak resident memory of its largest rank, as the kernel measured it.
 #[test]
 fn a_level_predicted_over_the_memory_is_not_begun_and_the_run_says_so() {
-    let dir = scratch("accuracy_memory");
-    let scene = repo().join("cases/references/moes-m10-l6.toml");
-    let run = dir.join("run");
-    let args = [
-        scene.to_str().unwrap(),
-        "--output",
-        run.to_str().unwrap(),
-        "--set",
-        "accuracy.target=0.05",
-        "--set",
-        "mesh.contact_size=0.5",
-        "-ehl_memory_per_rank",
-        "0.1",
-    ];
-    let out = mpirun(2, &args);
+    let (out, s) = moes_m10_with("accuracy_memory", &[], &["-ehl_memory_per_rank", "0.1"]);
     let log = text(&out);
     assert_eq!(out.status.code(), Some(4), "{log}");
     assert!(log.contains("GB per rank from level 0's peak") && log.contains("(-ehl_memory_per_rank)"), "{log}");
-    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).unwrap()).unwrap();
     let acc = &s["accuracy"];
     assert_eq!(acc["reached"], false, "{acc}");
     assert!(acc["not_reached_because"].as_str().unwrap().contains("0.1 GB a rank may reach"), "{acc}");

@@ -1230,7 +1230,7 @@ fn memory_left(ctx: &Context, levels: &[Level], previous: Option<&Solved>, conde
         None => {
             use mpi::traits::Communicator;
             let here = ctx.world.split_shared(0).size().max(1) as f64;
-            match (memory::resident_mb(), memory::node_free_mb()) {
+            match (crate::output::resident_mb(), memory::node_free_mb()) {
                 (Some(r), Some(f)) => r + f / here,
                 _ => f64::INFINITY,
             }

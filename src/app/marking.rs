@@ -562,19 +562,32 @@ pub struct TimeLeft {
 impl TimeLeft {
     /// The wall time a level of `n` unknowns is expected to take (s).
     pub fn predicted(&self, n: u64) -> f64 {
-        self.seconds * (n as f64 / self.before.max(1) as f64).powf(LEVEL_TIME_EXPONENT)
+        grown(self.seconds, self.before, n, LEVEL_TIME_EXPONENT)
     }
 
     /// The most unknowns a level may have and be expected to end within the time left.
     pub fn unknowns(&self) -> u64 {
-        if self.left <= 0.0 {
-            return 0;
-        }
-        if self.seconds <= 0.0 {
-            return u64::MAX;
-        }
-        (self.before as f64 * (self.left / self.seconds).powf(1.0 / LEVEL_TIME_EXPONENT)).min(u64::MAX as f64) as u64
+        unknowns_within(self.before, self.seconds, self.left, LEVEL_TIME_EXPONENT)
     }
+}
+
+/// A level's cost (its time, its memory) at `n` unknowns, from the `cost` of a level of
+/// `before` unknowns, growing like the unknowns to the power `exponent`.
+pub(super) fn grown(cost: f64, before: u64, n: u64, exponent: f64) -> f64 {
+    cost * (n as f64 / before.max(1) as f64).powf(exponent)
+}
+
+/// The most unknowns a level may have for its cost ([`grown`] from `cost` at `before`
+/// unknowns) to stay within `limit`: none without a limit left, any number where the level
+/// before cost nothing.
+pub(super) fn unknowns_within(before: u64, cost: f64, limit: f64, exponent: f64) -> u64 {
+    if limit <= 0.0 {
+        return 0;
+    }
+    if !(cost > 0.0) {
+        return u64::MAX;
+    }
+    (before as f64 * (limit / cost).powf(1.0 / exponent)).min(u64::MAX as f64) as u64
 }
 
 /// How many of the marked triangles (those of largest indicator) a level cut to `budget`

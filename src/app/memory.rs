@@ -54,17 +54,13 @@ pub struct MemoryLeft {
 impl MemoryLeft {
     /// The peak resident memory a level of `n` unknowns is expected to reach (MB).
     pub fn predicted(&self, n: u64) -> f64 {
-        self.peak_mb * (n as f64 / self.before.max(1) as f64).powf(self.exponent)
+        super::marking::grown(self.peak_mb, self.before, n, self.exponent)
     }
 
     /// The most unknowns a level may have and be expected to fit [`MEMORY_FILL`] of the
     /// room.
     pub fn unknowns(&self) -> u64 {
-        if !(self.peak_mb > 0.0) || self.room_mb.is_infinite() {
-            return u64::MAX;
-        }
-        let n = self.before as f64 * (MEMORY_FILL * self.room_mb.max(0.0) / self.peak_mb).powf(1.0 / self.exponent);
-        n.min(u64::MAX as f64) as u64
+        super::marking::unknowns_within(self.before, self.peak_mb, MEMORY_FILL * self.room_mb, self.exponent)
     }
 }
 
@@ -97,14 +93,6 @@ pub fn node_free_mb() -> Option<f64> {
         (Some(a), Some(c)) => Some(a.min(c)),
         (a, c) => a.or(c),
     }
-}
-
-/// This process's present resident memory (MB), from /proc/self/statm.
-pub fn resident_mb() -> Option<f64> {
-    let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
-    let pages: f64 = statm.split_whitespace().nth(1)?.parse().ok()?;
-    let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
-    (page > 0).then(|| pages * page as f64 / (1024.0 * 1024.0))
 }
 
 #[cfg(test)]
@@ -152,7 +140,7 @@ mod tests {
 
     #[test]
     fn this_process_has_a_resident_memory_and_the_node_some_free() {
-        let r = resident_mb().expect("/proc/self/statm");
+        let r = crate::output::resident_mb().expect("/proc/self/status");
         assert!(r > 0.0 && r < 1e6, "{r} MB");
         assert!(node_free_mb().is_some_and(|f| f >= 0.0));
     }

@@ -185,13 +185,16 @@ static EARLIER_PEAK_KB: std::sync::atomic::AtomicI64 = std::sync::atomic::Atomic
 /// Peak resident memory of this process in MiB (getrusage ru_maxrss, and the peaks before
 /// any [`restart_peak`]).
 pub fn peak_rss_mb() -> f64 {
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } == 0 {
-        let earlier = EARLIER_PEAK_KB.load(std::sync::atomic::Ordering::Relaxed);
-        usage.ru_maxrss.max(earlier) as f64 / 1024.0
-    } else {
-        f64::NAN
+    match max_rss_kb() {
+        Some(kb) => kb.max(EARLIER_PEAK_KB.load(std::sync::atomic::Ordering::Relaxed)) as f64 / 1024.0,
+        None => f64::NAN,
     }
+}
+
+/// getrusage's ru_maxrss of this process (kB): the kernel's high-water mark.
+fn max_rss_kb() -> Option<i64> {
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    (unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } == 0).then_some(usage.ru_maxrss)
 }
 
 /// Starts a new peak (Linux 4.0 and later: "5" to /proc/self/clear_refs resets the
@@ -199,9 +202,8 @@ pub fn peak_rss_mb() -> f64 {
 /// gives the peak of what follows; [`peak_rss_mb`] keeps the process's. Without it the
 /// peak since is the process's.
 pub fn restart_peak() {
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } == 0 {
-        EARLIER_PEAK_KB.fetch_max(usage.ru_maxrss, std::sync::atomic::Ordering::Relaxed);
+    if let Some(kb) = max_rss_kb() {
+        EARLIER_PEAK_KB.fetch_max(kb, std::sync::atomic::Ordering::Relaxed);
         let _ = std::fs::write("/proc/self/clear_refs", "5");
     }
 }
@@ -209,11 +211,18 @@ pub fn restart_peak() {
 /// Peak resident memory since the last [`restart_peak`] (MiB; `VmHWM` of /proc/self/status),
 /// or the process's where that cannot be read.
 pub fn peak_since_mb() -> f64 {
-    let hwm = std::fs::read_to_string("/proc/self/status").ok().and_then(|s| {
-        let line = s.lines().find(|l| l.starts_with("VmHWM:"))?.to_string();
-        line.split_whitespace().nth(1)?.parse::<f64>().ok()
-    });
-    hwm.map_or_else(peak_rss_mb, |kb| kb / 1024.0)
+    status_kb("VmHWM:").map_or_else(peak_rss_mb, |kb| kb / 1024.0)
+}
+
+/// This process's present resident memory (MiB; `VmRSS` of /proc/self/status).
+pub fn resident_mb() -> Option<f64> {
+    status_kb("VmRSS:").map(|kb| kb / 1024.0)
+}
+
+/// A `field` of /proc/self/status given in kB.
+fn status_kb(field: &str) -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    s.lines().find(|l| l.starts_with(field))?.split_whitespace().nth(1)?.parse().ok()
 }
 
 #[cfg(test)]
