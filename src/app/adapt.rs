@@ -52,7 +52,7 @@ use super::marking::{
 };
 use super::memory::{self, MemoryLeft};
 use super::{Context, Outcome};
-use crate::case::schema::RAISED_GRADIENT_JUMP;
+use crate::case::schema::{Accuracy, RAISED_GRADIENT_JUMP};
 use crate::case::{CavitationModel, Scene};
 use crate::collective;
 use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, RampLimits, Start, Tries};
@@ -286,76 +286,207 @@ pub struct Adapted {
     pub newton_iterations: usize,
 }
 
+/// What one step of a level's try leads to.
+enum Step<T> {
+    /// On to the next step, with what this one made.
+    On(T),
+    /// The level is tried again: on another mesh, from another start or with a remedy.
+    Again,
+    /// The run ends: with its written result, or with the error that stopped it.
+    Done(Box<Result<Adapted, Error>>),
+}
+
+impl<T> Step<T> {
+    /// The run's end with `end`.
+    fn end(end: Result<Adapted, Error>) -> Self {
+        Step::Done(Box::new(end))
+    }
+}
+
+/// The product of a [`Step`]; on [`Step::Again`] the loop's next pass, on [`Step::Done`]
+/// the run's end.
+macro_rules! step {
+    ($step:expr) => {
+        match $step {
+            Step::On(v) => v,
+            Step::Again => continue,
+            Step::Done(end) => return *end,
+        }
+    };
+}
+
 /// Runs the adaptive loop of a lubricated single-point scene with `accuracy.target > 0`.
 /// Collective. When the target cannot be reached (`max_levels`, `max_unknowns`, every
 /// triangle at the smallest size) the last level's result is written with its estimated
 /// error and the returned outcome is [`Outcome::ShortOfTarget`], saying why (exit 4).
+///
+/// Each pass of the loop is one try of a level, in the steps of the module documentation.
 pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::EarlierRun>) -> Result<Adapted, Error> {
-    // The scene as solved: the gradient-jump factor may be raised on the way (below).
-    let mut own = scene.clone();
-    let acc = scene.accuracy;
-    let target = acc.target;
-    let max_levels = acc.max_levels as usize;
-    ctx.log(format!(
-        "accuracy: target {target} (relative error of hc and hm{}): adaptive refinement of the contact face, at most {max_levels} levels after the first and {} unknowns per level",
-        if scene.effects.friction == crate::case::FrictionModel::Off { "" } else { ", fx and fz" },
-        acc.max_unknowns
-    ));
-    let mut levels: Vec<Level> = Vec::new();
-    // The next level's size field with its halvings (None: the scene's own mesh).
-    let mut next: Option<NextMesh> = None;
-    let mut previous: Option<Solved> = None;
-    let growth = scene.mesh.growth;
-    // Tries of the first level on a finer mesh after it failed on the scene's own.
-    let mut first_retries = 0;
-    // The level that may be meshed again with zone marking if it does not converge on its
-    // goal-oriented mesh.
-    let mut zone_retry: Option<usize> = None;
-    // The level solved again with the load and speed continuations and the Hertz start.
-    let mut full_ladder: Option<usize> = None;
-    // Seconds of the present level's attempts that did not converge: part of its time.
-    let mut tried_s = 0.0;
-    // Where a failed first level got, with its mesh: the retry goes on from there ([`onward`]).
-    let mut from: Option<Onward> = None;
-    // Where the continuation of a level that failed before the raise of the gradient-jump
-    // factor got, on the level's mesh: its solve with the factor raised goes on from there.
-    let mut raised_from: Option<Reached> = None;
-    // How the present level is cut when all its marked triangles would exceed a budget, and
-    // the meshes tried for it that were over the budget (count, unknowns).
-    let mut cut: Option<Cut> = None;
-    let mut over: Vec<(usize, u64)> = Vec::new();
-    // The present level was made by quartering and its plain Newton failed: it is meshed
-    // again with the quartered triangles halved.
-    let mut halve_quartered = false;
-    // The present level is the mesh of the level before solved again as complementarity
-    // (the cavitation penalty's own error stood in the way there).
-    let mut again = false;
+    let mut run = Loop::new(ctx, scene, earlier);
     loop {
-        let scene = &own;
-        if std::mem::take(&mut halve_quartered) {
-            if let Some(halved) = previous.as_mut().and_then(|p| p.halved_marking(growth)) {
-                next = Some(halved);
+        // The level's scene: the run's may change for the levels after it (the
+        // gradient-jump factor raised, cavitation as complementarity).
+        let scene = run.own.clone();
+        let k = run.levels.len();
+        let t0 = Instant::now();
+        // Step 1: the scene's mesh, or the level before's marking refined.
+        let setup = step!(run.mesh(&scene, k));
+        // Step 5: within the budgets, or cut to them, or not begun.
+        step!(run.within_budgets(&scene, &setup, k));
+        // Steps 3, 4 and 2: solved (with the remedies when it fails), estimated, and the
+        // next level marked.
+        let solved = step!(run.solve(&scene, setup, k, t0));
+        // Steps 6 and 7: the end at the target or a limit, the mesh again as
+        // complementarity, or the next level's mesh.
+        step!(run.after(&scene, solved, k));
+    }
+}
+
+/// The adaptive loop's state from one try of a level to the next.
+struct Loop<'c> {
+    ctx: &'c Context,
+    /// The earlier run whose state the first level goes on from (`--restart`).
+    earlier: Option<&'c super::restart::EarlierRun>,
+    acc: Accuracy,
+    /// The scene as solved: the gradient-jump factor may be raised, and cavitation turned
+    /// to complementarity, on the way.
+    own: Scene,
+    /// The levels solved, one per converged level (a retried first level stays 0).
+    levels: Vec<Level>,
+    /// The next level's size field with its halvings (None: the scene's own mesh).
+    next: Option<NextMesh>,
+    /// The last level solved.
+    previous: Option<Solved>,
+    /// Tries of the first level on a finer mesh after it failed on the scene's own.
+    first_retries: usize,
+    /// The level that may be meshed again with zone marking if it does not converge on its
+    /// goal-oriented mesh.
+    zone_retry: Option<usize>,
+    /// The level solved again with the load and speed continuations and the Hertz start.
+    full_ladder: Option<usize>,
+    /// Seconds of the present level's attempts that did not converge: part of its time.
+    tried_s: f64,
+    /// Where a failed first level got, with its mesh: the retry goes on from there
+    /// ([`onward`]).
+    from: Option<Onward>,
+    /// Where the continuation of a level that failed before the raise of the gradient-jump
+    /// factor got, on the level's mesh: its solve with the factor raised goes on from there.
+    raised_from: Option<Reached>,
+    /// How the present level is cut when all its marked triangles would exceed a budget.
+    cut: Option<Cut>,
+    /// The meshes tried for the present level that were over the budget (count, unknowns).
+    over: Vec<(usize, u64)>,
+    /// The present level was made by quartering and its plain Newton failed: it is meshed
+    /// again with the quartered triangles halved.
+    halve_quartered: bool,
+    /// The present level is the mesh of the level before solved again as complementarity
+    /// (the cavitation penalty's own error stood in the way there).
+    again: bool,
+}
+
+/// How a level's solve failed, with what its remedy needs.
+enum Failed {
+    /// The level before's mesh, solved again as complementarity from its solution.
+    Again(Error),
+    /// A refined level, and the remedy [`remedy`] chose for it.
+    Refined(Error, Remedy),
+    /// The first level.
+    First(Error),
+    /// The first level from an earlier run's state (`--restart`): not retried.
+    Earlier(Error),
+}
+
+/// What the record of a level leaves for its [`Solved`] and for the loop's decision.
+struct LevelEnd {
+    marking: Option<Marking>,
+    friction: Option<FrictionResult>,
+    exponents: Option<serde_json::Value>,
+    edges: Vec<f64>,
+    reached: bool,
+}
+
+/// A level solved and recorded, before the loop decides what follows it: its state, its
+/// contact triangles' longest edges, and whether it reached the target.
+struct Recorded {
+    here: Solved,
+    edges: Vec<f64>,
+    reached: bool,
+}
+
+impl<'c> Loop<'c> {
+    fn new(ctx: &'c Context, scene: &Scene, earlier: Option<&'c super::restart::EarlierRun>) -> Self {
+        let acc = scene.accuracy;
+        ctx.log(format!(
+            "accuracy: target {} (relative error of hc and hm{}): adaptive refinement of the contact face, at most {} levels after the first and {} unknowns per level",
+            acc.target,
+            if scene.effects.friction == crate::case::FrictionModel::Off { "" } else { ", fx and fz" },
+            acc.max_levels,
+            acc.max_unknowns
+        ));
+        Loop {
+            ctx,
+            earlier,
+            acc,
+            own: scene.clone(),
+            levels: Vec::new(),
+            next: None,
+            previous: None,
+            first_retries: 0,
+            zone_retry: None,
+            full_ladder: None,
+            tried_s: 0.0,
+            from: None,
+            raised_from: None,
+            cut: None,
+            over: Vec::new(),
+            halve_quartered: false,
+            again: false,
+        }
+    }
+
+    /// After level `k` stopped with `e`: the last converged level's result when the time
+    /// budget was spent, or the error ([`out_of_time`]).
+    fn stopped(&self, scene: &Scene, k: usize, e: Error) -> Result<Adapted, Error> {
+        out_of_time(self.ctx, scene, self.previous.as_ref(), k, &self.levels, e)
+    }
+
+    /// The run's end with the level before's result, short of the target because of `why`.
+    fn short(&self, scene: &Scene, prev: &Solved, k: usize, why: &str) -> Step<()> {
+        let why = short_of(self.acc.target, why, k - 1, self.levels.last().and_then(|l| l.est));
+        Step::end(finish(self.ctx, scene, prev, self.acc.target, &self.levels, Some(why)))
+    }
+
+    /// Step 1: the level's mesh, from the level before's marking (with its quartered
+    /// triangles halved after a quartered try failed), or the scene's own.
+    fn mesh(&mut self, scene: &Scene, k: usize) -> Step<Setup> {
+        if std::mem::take(&mut self.halve_quartered) {
+            if let Some(halved) = self.previous.as_mut().and_then(|p| p.halved_marking(scene.mesh.growth)) {
+                self.next = Some(halved);
             }
         }
-        // The level being solved: one per converged level (a retried first level stays 0).
-        let k = levels.len();
-        let t0 = Instant::now();
-        let setup = match Setup::with_size_field(ctx, scene, next.as_ref().map(|m| m.field.clone())) {
-            Ok(s) => s,
-            Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
-        };
+        match Setup::with_size_field(self.ctx, scene, self.next.as_ref().map(|m| m.field.clone())) {
+            Ok(s) => Step::On(s),
+            Err(e) => Step::end(self.stopped(scene, k, e)),
+        }
+    }
+
+    /// Step 5 before the solve: a level over `accuracy.max_unknowns`, the time left or the
+    /// memory a rank may reach is meshed again with its quartered triangles halved, cut to
+    /// the budget, or not begun (the run ends with the level before's result).
+    fn within_budgets(&mut self, scene: &Scene, setup: &Setup, k: usize) -> Step<()> {
+        let (ctx, acc, target, growth) = (self.ctx, self.acc, self.acc.target, scene.mesh.growth);
         let (n_u, n_p) = setup.layout.counts();
         let n = (n_u + n_p + 1) as u64;
         // The time budget as a bound on the level's unknowns: what the level before's cost
         // per unknown lets end in the time left. A level that would not end in it is cut
         // or not begun, rather than abandoned at the deadline after most of its cost.
-        let time = time_left(ctx, acc, &levels, previous.as_ref());
+        let time = time_left(ctx, acc, &self.levels, self.previous.as_ref());
         let by_time = time.filter(|t| t.unknowns() < acc.max_unknowns);
         let budget = by_time.map_or(acc.max_unknowns, |t| t.unknowns());
         // The memory as a bound too: a level the node cannot hold is cut or not begun,
         // rather than killed with the run.
-        let condensed = Coupling::of_scene(scene, n_p, previous.is_some()) == Coupling::Condensed;
-        let by_memory = memory_left(ctx, &levels, previous.as_ref(), condensed).filter(|m| m.unknowns() < budget);
+        let condensed = Coupling::of_scene(scene, n_p, self.previous.is_some()) == Coupling::Condensed;
+        let by_memory = memory_left(ctx, &self.levels, self.previous.as_ref(), condensed).filter(|m| m.unknowns() < budget);
         let by_time = by_time.filter(|_| by_memory.is_none());
         let budget = by_memory.map_or(budget, |m| m.unknowns());
         let budget_by = match (by_memory, by_time) {
@@ -368,96 +499,99 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // (cases/hard/spin-0.5deg: quartered, level 4 would have had 998,894 unknowns).
         // The marking then halves, here and in a cut below.
         // A level solved again on its own mesh was within its budget.
-        let over_budget = n > budget && !again;
-        if let Some(prev) = previous.as_mut().filter(|p| over_budget && p.marking.as_ref().is_some_and(|m| m.quartered() > 0)) {
+        let over_budget = n > budget && !self.again;
+        if let Some(prev) = self.previous.as_mut().filter(|p| over_budget && p.marking.as_ref().is_some_and(|m| m.quartered() > 0)) {
             ctx.log(format!(
                 "accuracy: level {k} would have {n} unknowns, above its budget of {budget} ({}); again with its {} quartered triangles halved",
                 budget_by.key(),
                 prev.marking.as_ref().map_or(0, |m| m.quartered())
             ));
-            next = prev.halved_marking(growth);
-            continue;
+            self.next = prev.halved_marking(growth);
+            return Step::Again;
         }
-        if let (Some(prev), true) = (&previous, over_budget) {
-            // The level is cut to the budget: the marked triangles of largest indicator that
-            // fit, once per run (a cut level is the last, below), and not when even the next
-            // full level's change could not take every estimate below the target.
-            let before = levels.last().map_or(0, |l| l.unknowns() as u64);
-            let over_what = match (by_memory, by_time) {
-                (Some(m), _) => format!(
-                    "level {k} would have {n} unknowns and need about {:.1} GB per rank from level {}'s peak ({:.1} GB at {} unknowns), more than {:.0} % of the {:.1} GB a rank may reach ({})",
-                    m.predicted(n) / 1024.0,
-                    k - 1,
-                    m.peak_mb / 1024.0,
-                    m.before,
-                    100.0 * super::memory::MEMORY_FILL,
-                    m.room_mb / 1024.0,
-                    match crate::ehl_options::get().memory_per_rank_gb {
-                        Some(_) => "-ehl_memory_per_rank".to_string(),
-                        None => "its memory now and its share of the node's free memory; -ehl_memory_per_rank sets it".to_string(),
-                    }
-                ),
-                (None, Some(t)) => format!(
-                    "level {k} would have {n} unknowns and take about {:.0} s at level {}'s cost ({} unknowns in {:.0} s), more than the {:.0} s left of accuracy.max_seconds = {} s",
-                    t.predicted(n),
-                    k - 1,
-                    t.before,
-                    t.seconds,
-                    t.left.max(0.0),
-                    acc.max_seconds
-                ),
-                (None, None) => format!("level {k} would have {n} unknowns, above accuracy.max_unknowns = {}", acc.max_unknowns),
-            };
-            // The cut this mesh leads to (none without a ranked marking, or after
-            // [`MAX_CUTS`] meshes).
-            let planned = prev
-                .marking
-                .as_ref()
-                .filter(|_| over.len() < MAX_CUTS)
-                .and_then(|m| PlannedCut::of(m, &over, cut, n, before, budget))
-                .filter(|p| p.count > 0);
-            let hopeful = planned.as_ref().is_some_and(|p| {
-                Estimate::cut_worth_solving(&levels, target, scene.effects.cavitation == CavitationModel::Penalty, p.share)
-            });
-            // A cut level kept from the target by the cavitation penalty's part alone: the
-            // level before is solved again as complementarity, and the cut is gated and
-            // estimated on that sequence (below, step 7 of the module documentation).
-            let penalty_alone = planned.is_some()
-                && !hopeful
-                && scene.effects.cavitation == CavitationModel::Penalty
-                && levels.last().is_some_and(|l| l.penalty.is_some())
-                && Estimate::cut_could_reach(&levels, target, false);
-            if penalty_alone {
-                let why = format!("{over_what}, and the cavitation penalty's part alone keeps a level cut to it from the target");
-                to_complementarity(ctx, &mut own, k - 1, &why);
-                next = prev.mesh_from.clone();
-                again = true;
-                continue;
-            }
-            let refused = planned.as_ref().filter(|_| !hopeful).map(|p| {
-                format!(
-                    " (a level cut to it, the {} of the {} marked triangles with the largest indicator, {:.0} % of it, could not take every estimate below the target)",
-                    p.count,
-                    p.marked,
-                    100.0 * p.share
-                )
-            });
-            if let Some(PlannedCut { marking, marked, tried, count, share }) = planned.filter(|_| hopeful) {
-                over = tried;
-                if share >= MIN_BUDGET_SHARE {
-                    ctx.log(format!(
-                        "accuracy: {over_what}; it refines the {count} of the {marked} marked triangles with the largest indicator instead ({:.0} % of their indicator)",
-                        100.0 * share
-                    ));
-                    next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), marking, Some(count), growth));
-                    cut = Some(Cut { count, share, by: budget_by });
-                    continue;
+        let (Some(prev), true) = (&self.previous, over_budget) else { return Step::On(()) };
+        // The level is cut to the budget: the marked triangles of largest indicator that
+        // fit, once per run (a cut level is the last, below), and not when even the next
+        // full level's change could not take every estimate below the target.
+        let before = self.levels.last().map_or(0, |l| l.unknowns() as u64);
+        let over_what = match (by_memory, by_time) {
+            (Some(m), _) => format!(
+                "level {k} would have {n} unknowns and need about {:.1} GB per rank from level {}'s peak ({:.1} GB at {} unknowns), more than {:.0} % of the {:.1} GB a rank may reach ({})",
+                m.predicted(n) / 1024.0,
+                k - 1,
+                m.peak_mb / 1024.0,
+                m.before,
+                100.0 * super::memory::MEMORY_FILL,
+                m.room_mb / 1024.0,
+                match crate::ehl_options::get().memory_per_rank_gb {
+                    Some(_) => "-ehl_memory_per_rank".to_string(),
+                    None => "its memory now and its share of the node's free memory; -ehl_memory_per_rank sets it".to_string(),
                 }
-            }
-            let why = format!("{over_what}{}", refused.unwrap_or_default());
-            let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
-            return finish(ctx, scene, prev, target, &levels, Some(why));
+            ),
+            (None, Some(t)) => format!(
+                "level {k} would have {n} unknowns and take about {:.0} s at level {}'s cost ({} unknowns in {:.0} s), more than the {:.0} s left of accuracy.max_seconds = {} s",
+                t.predicted(n),
+                k - 1,
+                t.before,
+                t.seconds,
+                t.left.max(0.0),
+                acc.max_seconds
+            ),
+            (None, None) => format!("level {k} would have {n} unknowns, above accuracy.max_unknowns = {}", acc.max_unknowns),
+        };
+        // The cut this mesh leads to (none without a ranked marking, or after
+        // [`MAX_CUTS`] meshes).
+        let planned = prev
+            .marking
+            .as_ref()
+            .filter(|_| self.over.len() < MAX_CUTS)
+            .and_then(|m| PlannedCut::of(m, &self.over, self.cut, n, before, budget))
+            .filter(|p| p.count > 0);
+        let hopeful = planned.as_ref().is_some_and(|p| {
+            Estimate::cut_worth_solving(&self.levels, target, scene.effects.cavitation == CavitationModel::Penalty, p.share)
+        });
+        // A cut level kept from the target by the cavitation penalty's part alone: the
+        // level before is solved again as complementarity, and the cut is gated and
+        // estimated on that sequence (below, step 7 of the module documentation).
+        let penalty_alone = planned.is_some()
+            && !hopeful
+            && scene.effects.cavitation == CavitationModel::Penalty
+            && self.levels.last().is_some_and(|l| l.penalty.is_some())
+            && Estimate::cut_could_reach(&self.levels, target, false);
+        if penalty_alone {
+            let why = format!("{over_what}, and the cavitation penalty's part alone keeps a level cut to it from the target");
+            to_complementarity(ctx, &mut self.own, k - 1, &why);
+            self.next = prev.mesh_from.clone();
+            self.again = true;
+            return Step::Again;
         }
+        let refused = planned.as_ref().filter(|_| !hopeful).map(|p| {
+            format!(
+                " (a level cut to it, the {} of the {} marked triangles with the largest indicator, {:.0} % of it, could not take every estimate below the target)",
+                p.count,
+                p.marked,
+                100.0 * p.share
+            )
+        });
+        if let Some(PlannedCut { marking, marked, tried, count, share }) = planned.filter(|_| hopeful) {
+            self.over = tried;
+            if share >= MIN_BUDGET_SHARE {
+                ctx.log(format!(
+                    "accuracy: {over_what}; it refines the {count} of the {marked} marked triangles with the largest indicator instead ({:.0} % of their indicator)",
+                    100.0 * share
+                ));
+                self.next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), marking, Some(count), growth));
+                self.cut = Some(Cut { count, share, by: budget_by });
+                return Step::Again;
+            }
+        }
+        self.short(scene, prev, k, &format!("{over_what}{}", refused.unwrap_or_default()))
+    }
+
+    /// Steps 3, 4 and 6 of a level: its solve from the level before (with the remedies
+    /// when that fails), its record with the estimate, and the next level's marking.
+    fn solve(&mut self, scene: &Scene, setup: Setup, k: usize, t0: Instant) -> Step<Recorded> {
+        let ctx = self.ctx;
         // A level after one that plain Newton could not solve from its own coarser level
         // goes to the continuation at once (level 0 is not a guide: its start is the Hertz
         // pressure, not a coarser level's), unless that continuation was a load or speed
@@ -465,236 +599,38 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // L = 0.01 with level 0 at 0.0625 a (the load path from L/5.2): level 1 failed plain
         // Newton, and levels 2-4 went through the load path at once, 63-87 iterations each,
         // where plain Newton from a finer coarser level took 20-25.
-        let continued_near = previous.as_ref().is_some_and(|p| p.sol.continued && !p.sol.milder.as_ref().is_some_and(|m| m.last_resort));
+        let continued_near =
+            self.previous.as_ref().is_some_and(|p| p.sol.continued && !p.sol.milder.as_ref().is_some_and(|m| m.last_resort));
         let plain = !(k >= 2 && continued_near);
         // From a coarser level's pressure, plain Newton's few steps do not pay back a
         // condensation; a continuation's many steps do, on the condensed coupling's cheaper
         // ones (M = 500, L = 15's level 2, 2,684 pressure unknowns: 16.2 s condensed, 36
         // iterations; 22.9 s monolithic, 42).
-        let sequenced = (previous.is_some() && plain) || earlier.is_some();
+        let sequenced = (self.previous.is_some() && plain) || self.earlier.is_some();
         // The level's own peak memory, for its report and the next level's prediction.
         crate::output::restart_peak();
         let mut solver = match EhlSolver::new(ctx, scene, &setup.mesh, &setup.part, &setup.dofs, &setup.layout, setup.half, sequenced) {
             Ok(s) => s,
-            Err(e) => return out_of_time(ctx, scene, previous.as_ref(), k, &levels, e),
+            Err(e) => return Step::end(self.stopped(scene, k, e)),
         };
         // The adjoint after the level solves on Newton's last factorisation.
         // The complementarity form has no penalty error to estimate.
         let penalised = scene.effects.cavitation == CavitationModel::Penalty;
-        solver.keep_newton(acc.marking > 0.0 || scene.output.speed_exponents || penalised);
+        solver.keep_newton(self.acc.marking > 0.0 || scene.output.speed_exponents || penalised);
         // A staged penalty that stalls short of the scene's is judged by its error here.
         solver.accept_short_penalty(true);
-        let sol = match (&previous, earlier) {
-            // The penalty level's mesh as complementarity, from its solution. Where that does
-            // not converge, the penalty level stays and the levels after it solve
-            // complementarity from its pressure.
-            (Some(prev), _) if again => match collective::agree(&ctx.world, solve_again(ctx, scene, &solver, prev, k - 1)) {
-                Ok(sol) => sol,
-                Err(e) if crate::interrupt::agreed() == 0 && newton_failed(ctx, &e) => {
-                    drop(solver);
-                    again = false;
-                    let why =
-                        format!("level {} did not converge as complementarity from its solution with the penalty ({})", k - 1, reason(&e));
-                    match prev.marking.as_ref() {
-                        Some(m) => {
-                            ctx.log(format!("accuracy: {why}; the levels after it solve complementarity from its pressure"));
-                            next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), m, None, growth));
-                            tried_s += t0.elapsed().as_secs_f64();
-                            continue;
-                        }
-                        // The penalty level was the last one the budget allows.
-                        None => {
-                            let why = short_of(target, &why, k - 1, levels.last().and_then(|l| l.est));
-                            return finish(ctx, scene, prev, target, &levels, Some(why));
-                        }
+        let sol = match self.attempt(scene, &setup, &solver, plain, k) {
+            Ok(sol) => sol,
+            Err(failed) => {
+                drop(solver);
+                return match self.remedied(scene, setup, failed, k) {
+                    Step::On(()) => {
+                        self.tried_s += t0.elapsed().as_secs_f64();
+                        Step::Again
                     }
-                }
-                Err(e) => {
-                    drop(solver);
-                    return out_of_time(ctx, scene, Some(prev), k, &levels, e);
-                }
-            },
-            (Some(prev), _) => {
-                let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
-                let p = |x: f64, z: f64| pf.at(x, z).map_or(0.0, |v| v.0);
-                let label = format!("level {}'s pressure ({} contact triangles)", k - 1, prev.setup.mesh.contact_tris.len());
-                // The previous level's state short of the scene, when it came through a
-                // continuation: this level's continuation starts its milder problem there.
-                let mf = prev.sol.milder.as_ref().map(|path| FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &path.x));
-                let pm = |x: f64, z: f64| mf.as_ref().and_then(|f| f.at(x, z)).map_or(0.0, |v| v.0);
-                let mild_label = format!("level {}'s state", k - 1);
-                let milder = prev.sol.milder.as_ref().zip(mf.as_ref()).map(|(path, f)| Milder {
-                    parameter: path.parameter,
-                    ts: &path.ts,
-                    p: &pm,
-                    hc: f.stats().hc,
-                    label: &mild_label,
-                });
-                // While the gradient-jump factor can still be raised, a level that fails the
-                // continuations nearest the scene is solved again with it raised (below)
-                // before the load and speed continuations and the Hertz start: at M = 100,
-                // L = 20 those cost 330 s on level 3 and never converged from a coarser
-                // level's pressure. A failure the raise does not answer gets them after all.
-                let raisable = scene.reynolds.gradient_jump > 0.0 && scene.reynolds.gradient_jump < RAISED_GRADIENT_JUMP;
-                // A level made by quartering tries plain Newton alone: if that fails it is
-                // meshed again halved (below), which converged by plain Newton where the
-                // quartered level needed the continuation and the raise (a traction drive at
-                // L = 22: 62 s to a tighter target against 638 s, docs/practice.md).
-                let quartered = next.as_ref().is_some_and(|m| m.halvings == 2) && raised_from.is_none() && full_ladder != Some(k);
-                let tries = match (plain, quartered) {
-                    (false, _) => Tries::Continuation,
-                    (true, true) => Tries::Plain,
-                    (true, false) => Tries::PlainThenContinuation,
+                    Step::Again => Step::Again,
+                    Step::Done(end) => Step::Done(end),
                 };
-                let last_resorts = (!raisable || full_ladder == Some(k)) && tries != Tries::Plain;
-                // A monolithic level after a monolithic one starts from its displacement.
-                let coarser = (prev.sol.coupling == Coupling::Monolithic).then_some(Coarser {
-                    mesh: &prev.setup.mesh,
-                    layout: &prev.setup.layout,
-                    x: &prev.sol.x,
-                });
-                // While the factor can be raised, a ramp gives up at its second failed step:
-                // the raised solve goes on from the furthest state the ramp converged at.
-                // M = 40, L = 15's 0.03125 a level failed four ramp steps at c_J = 0.01
-                // (alpha 25.6 -> 36.2 -> 39.5 GPa^-1 between its converged ones, 254 s),
-                // then converged with c_J = 1 in 26 iterations (48 s). Once it is raised,
-                // only the last resorts are left, and the ramp takes smaller steps before it
-                // gives up ([`RampLimits::PATIENT`]); docs/accuracy.md, "The ramp's second
-                // failure".
-                let ramp = match (raisable, scene.reynolds.gradient_jump >= RAISED_GRADIENT_JUMP) {
-                    (true, _) => RampLimits::BEFORE_A_REMEDY,
-                    (false, true) => RampLimits::PATIENT,
-                    (false, false) => RampLimits::DEFAULT,
-                };
-                let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, tries, milder, last_resorts, ramp, coarser };
-                // After the raise: first from the failed try's furthest state (its milder
-                // problem, on this same mesh), without the last resorts; if that fails, from
-                // the coarser level's state as before. At M = 1000, L = 20 the try with
-                // c_J = 0.01 got to alpha = 48.3 of 68.3 GPa^-1 on the 0.0156 a level, and
-                // the raised solve spent 146 s getting there again from the coarser level's
-                // alpha/4; at M = 20, L = 20 the raised ramp from the try's 44.3 GPa^-1
-                // failed at 64.7 -> 68.3, where the one from the coarser level's alpha/2
-                // converges (docs/accuracy.md).
-                let onward_state = raised_from.take();
-                let solved = match &onward_state {
-                    Some(r) => {
-                        let label = format!("level {k}'s state where its try before the raise stopped");
-                        from_reached(ctx, scene, &solver, &setup, r, &label, true)
-                    }
-                    None => solver.solve_from(ctx, scene, start),
-                };
-                let solved = collective::agree(&ctx.world, penalty_judged(ctx, &setup, target, solved));
-                match solved {
-                    Ok(sol) => sol,
-                    // What is tried next, in the order of [`remedy`].
-                    Err(e) => {
-                        let tried = Tried {
-                            plain_alone: tries == Tries::Plain,
-                            raisable,
-                            from_try_state: onward_state.is_some(),
-                            last_resorts,
-                            zone_retry: zone_retry == Some(k),
-                        };
-                        let remedy = remedy(&Failure::of(ctx, &e), &tried);
-                        drop(solver);
-                        match remedy {
-                            Remedy::HalveQuartered => {
-                                ctx.log(format!(
-                                    "accuracy: level {k} did not converge by plain Newton on its quartered mesh ({}); again with its {} quartered triangles halved",
-                                    reason(&e),
-                                    prev.marking.as_ref().map_or(0, |m| m.quartered())
-                                ));
-                                halve_quartered = true;
-                            }
-                            Remedy::Raise => {
-                                ctx.log(format!(
-                                    "accuracy: level {k} did not converge ({}); again on the same mesh with the gradient-jump factor reynolds.gradient_jump raised from {} to {RAISED_GRADIENT_JUMP} for this level and the ones after",
-                                    reason(&e),
-                                    scene.reynolds.gradient_jump
-                                ));
-                                raised_from = reached(ctx, &e);
-                                own.reynolds.gradient_jump = RAISED_GRADIENT_JUMP;
-                            }
-                            Remedy::FromCoarser => {
-                                ctx.log(format!(
-                                    "accuracy: level {k} did not converge from its try's state ({}); again from level {}'s state",
-                                    reason(&e),
-                                    k - 1
-                                ));
-                            }
-                            Remedy::FullLadder => {
-                                ctx.log(format!(
-                                    "accuracy: level {k} did not converge ({}); again on the same mesh with the load and speed continuations and the Hertz start",
-                                    reason(&e)
-                                ));
-                                full_ladder = Some(k);
-                            }
-                            Remedy::ZoneMesh => {
-                                ctx.log(format!(
-                                    "accuracy: level {k} did not converge on its goal-oriented mesh ({}); again with level {}'s pressurised zone refined",
-                                    reason(&e),
-                                    k - 1
-                                ));
-                                let edges = longest_edges(&prev.setup.mesh);
-                                let marked = zone_mark(&pf, &edges);
-                                next = Some(NextMesh::halving(Arc::new(next_field(&prev.setup.mesh, &edges, &marked, growth))));
-                                zone_retry = None;
-                            }
-                            Remedy::SpinPole => {
-                                return Err(Error::Context {
-                                    context: format!(
-                                        "accuracy: level {k} (level {} converged on its coarser mesh only, which does not resolve the spin pole; no result written)",
-                                        k - 1
-                                    ),
-                                    source: Box::new(e),
-                                });
-                            }
-                            Remedy::Short => {
-                                let why = short_of(
-                                    target,
-                                    &format!("level {k} did not converge ({e})"),
-                                    k - 1,
-                                    levels.last().and_then(|l| l.est),
-                                );
-                                return finish(ctx, scene, prev, target, &levels, Some(why));
-                            }
-                            Remedy::Stop => return out_of_time(ctx, scene, Some(prev), k, &levels, e),
-                        }
-                        tried_s += t0.elapsed().as_secs_f64();
-                        continue;
-                    }
-                }
-            }
-            (None, Some(e)) => collective::agree(&ctx.world, penalty_judged(ctx, &setup, target, e.solve(ctx, scene, &solver)))?,
-            (None, None) => {
-                match collective::agree(&ctx.world, penalty_judged(ctx, &setup, target, onward(ctx, scene, &solver, from.as_ref()))) {
-                    Ok(sol) => sol,
-                    // A first mesh too coarse for the film (at low speed or high load the side
-                    // lobes and the outlet constriction are narrower than 0.25 a, and the film
-                    // closes there on it: cases/hard/slow, heavy-3gpa) is refined in the Hertz
-                    // zone and, finer, around the radii where the film closed, and solved again
-                    // without the gradient-jump term ([`without_gradient_jump`]); a film that
-                    // closes at a spin pole closes on any mesh.
-                    // Every rank decides the same: only Newton's own failure (the same on every
-                    // rank) is retried, not one rank's local fault.
-                    Err(e) if crate::interrupt::agreed() == 0 && first_retries < FIRST_LEVEL_RETRIES && newton_failed(ctx, &e) => {
-                        let why = format!("did not converge on its mesh ({})", reason(&e));
-                        let closed = closures(ctx, &e);
-                        next = Some(NextMesh::halving(first_level_again(ctx, &setup.mesh, growth, &why, &closed)));
-                        if !closed.is_empty() {
-                            without_gradient_jump(ctx, &mut own);
-                        }
-                        first_retries += 1;
-                        tried_s += t0.elapsed().as_secs_f64();
-                        drop(solver);
-                        let further = |r: &Reached| !matches!(&from, Some(Onward::Reached(_, f)) if f.t >= r.t);
-                        if let Some(r) = reached(ctx, &e).filter(further) {
-                            from = Some(Onward::Reached(setup, r));
-                        }
-                        continue;
-                    }
-                    Err(e) => return Err(e),
-                }
             }
         };
         let fields = FieldsOnFace::new(&setup.mesh, &setup.layout, &sol.x);
@@ -703,7 +639,7 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // A first level whose film dips below zero between its nodes (the P2 film under a
         // spin pole or a side lobe narrower than its elements: cases/hard/spin-0.33deg at
         // 0.25 a) is refined and solved again like one that does not converge.
-        if unphysical && previous.is_none() && earlier.is_none() && first_retries < FIRST_LEVEL_RETRIES {
+        if unphysical && self.previous.is_none() && self.earlier.is_none() && self.first_retries < FIRST_LEVEL_RETRIES {
             let why = format!(
                 "converged to a film that is not positive everywhere (hm = {:.3e} at ({:.3}a, {:.3}a))",
                 st.hm, st.hm_at[0], st.hm_at[1]
@@ -715,80 +651,338 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             // unknowns and stopped at the budget one level earlier (fx 1.46 %, fz 1.37 %);
             // the halved zone has 92,600 and gets a level further (1.31 %, 1.03 %), with
             // the same films.
-            next = Some(NextMesh::halving(first_level_again(ctx, &setup.mesh, growth, &why, &[])));
-            first_retries += 1;
-            tried_s += t0.elapsed().as_secs_f64();
+            self.next = Some(NextMesh::halving(first_level_again(ctx, &setup.mesh, scene.mesh.growth, &why, &[])));
+            self.first_retries += 1;
+            self.tried_s += t0.elapsed().as_secs_f64();
+            drop(fields);
             drop(solver);
-            from = Some(Onward::Converged(setup, sol.x));
-            continue;
+            self.from = Some(Onward::Converged(setup, sol.x));
+            return Step::Again;
         }
         if unphysical {
-            return Err(Error::numerical(format!(
+            return Step::end(Err(Error::numerical(format!(
                 "accuracy: level {k} converged to an unphysical state (hc {}, hm {}); no result written",
                 st.hc, st.hm
-            )));
+            ))));
         }
+        match self.record(scene, &setup, &solver, &sol, &fields, t0) {
+            Ok(LevelEnd { marking, friction, exponents, edges, reached }) => {
+                let condensation_s = solver.condensation_s;
+                drop(fields);
+                drop(solver);
+                let here = Solved {
+                    setup,
+                    sol,
+                    hc: st.hc,
+                    condensation_s,
+                    exponents,
+                    gradient_jump: scene.reynolds.gradient_jump,
+                    cavitation: scene.effects.cavitation,
+                    marking,
+                    mesh_from: self.next.clone(),
+                    friction,
+                };
+                Step::On(Recorded { here, edges, reached })
+            }
+            Err(e) => Step::end(Err(e)),
+        }
+    }
+
+    /// Step 3: the level's solve, from the level before's state (its own mesh solved again
+    /// as complementarity, or a coarser level's pressure), an earlier run's, or the first
+    /// level's start. Collective.
+    fn attempt<'s>(&mut self, scene: &Scene, setup: &'s Setup, solver: &EhlSolver<'s>, plain: bool, k: usize) -> Result<EhlSolution, Failed>
+    where
+        'c: 's,
+    {
+        let ctx = self.ctx;
+        let target = self.acc.target;
+        let Some(prev) = &self.previous else {
+            return match self.earlier {
+                Some(e) => {
+                    collective::agree(&ctx.world, penalty_judged(ctx, setup, target, e.solve(ctx, scene, solver))).map_err(Failed::Earlier)
+                }
+                None => collective::agree(&ctx.world, penalty_judged(ctx, setup, target, onward(ctx, scene, solver, self.from.as_ref())))
+                    .map_err(Failed::First),
+            };
+        };
+        // The penalty level's mesh as complementarity, from its solution.
+        if self.again {
+            return collective::agree(&ctx.world, solve_again(ctx, scene, solver, prev, k - 1)).map_err(Failed::Again);
+        }
+        let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
+        let p = |x: f64, z: f64| pf.at(x, z).map_or(0.0, |v| v.0);
+        let label = format!("level {}'s pressure ({} contact triangles)", k - 1, prev.setup.mesh.contact_tris.len());
+        // The previous level's state short of the scene, when it came through a
+        // continuation: this level's continuation starts its milder problem there.
+        let mf = prev.sol.milder.as_ref().map(|path| FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &path.x));
+        let pm = |x: f64, z: f64| mf.as_ref().and_then(|f| f.at(x, z)).map_or(0.0, |v| v.0);
+        let mild_label = format!("level {}'s state", k - 1);
+        let milder = prev.sol.milder.as_ref().zip(mf.as_ref()).map(|(path, f)| Milder {
+            parameter: path.parameter,
+            ts: &path.ts,
+            p: &pm,
+            hc: f.stats().hc,
+            label: &mild_label,
+        });
+        // While the gradient-jump factor can still be raised, a level that fails the
+        // continuations nearest the scene is solved again with it raised (below)
+        // before the load and speed continuations and the Hertz start: at M = 100,
+        // L = 20 those cost 330 s on level 3 and never converged from a coarser
+        // level's pressure. A failure the raise does not answer gets them after all.
+        let raisable = scene.reynolds.gradient_jump > 0.0 && scene.reynolds.gradient_jump < RAISED_GRADIENT_JUMP;
+        // A level made by quartering tries plain Newton alone: if that fails it is
+        // meshed again halved (below), which converged by plain Newton where the
+        // quartered level needed the continuation and the raise (a traction drive at
+        // L = 22: 62 s to a tighter target against 638 s, docs/practice.md).
+        let quartered = self.next.as_ref().is_some_and(|m| m.halvings == 2) && self.raised_from.is_none() && self.full_ladder != Some(k);
+        let tries = match (plain, quartered) {
+            (false, _) => Tries::Continuation,
+            (true, true) => Tries::Plain,
+            (true, false) => Tries::PlainThenContinuation,
+        };
+        let last_resorts = (!raisable || self.full_ladder == Some(k)) && tries != Tries::Plain;
+        // A monolithic level after a monolithic one starts from its displacement.
+        let coarser = (prev.sol.coupling == Coupling::Monolithic).then_some(Coarser {
+            mesh: &prev.setup.mesh,
+            layout: &prev.setup.layout,
+            x: &prev.sol.x,
+        });
+        // While the factor can be raised, a ramp gives up at its second failed step:
+        // the raised solve goes on from the furthest state the ramp converged at.
+        // M = 40, L = 15's 0.03125 a level failed four ramp steps at c_J = 0.01
+        // (alpha 25.6 -> 36.2 -> 39.5 GPa^-1 between its converged ones, 254 s),
+        // then converged with c_J = 1 in 26 iterations (48 s). Once it is raised,
+        // only the last resorts are left, and the ramp takes smaller steps before it
+        // gives up ([`RampLimits::PATIENT`]); docs/accuracy.md, "The ramp's second
+        // failure".
+        let ramp = match (raisable, scene.reynolds.gradient_jump >= RAISED_GRADIENT_JUMP) {
+            (true, _) => RampLimits::BEFORE_A_REMEDY,
+            (false, true) => RampLimits::PATIENT,
+            (false, false) => RampLimits::DEFAULT,
+        };
+        let start = Start::Pressure { p: &p, hc: prev.hc, label: &label, tries, milder, last_resorts, ramp, coarser };
+        // After the raise: first from the failed try's furthest state (its milder
+        // problem, on this same mesh), without the last resorts; if that fails, from
+        // the coarser level's state as before. At M = 1000, L = 20 the try with
+        // c_J = 0.01 got to alpha = 48.3 of 68.3 GPa^-1 on the 0.0156 a level, and
+        // the raised solve spent 146 s getting there again from the coarser level's
+        // alpha/4; at M = 20, L = 20 the raised ramp from the try's 44.3 GPa^-1
+        // failed at 64.7 -> 68.3, where the one from the coarser level's alpha/2
+        // converges (docs/accuracy.md).
+        let onward_state = self.raised_from.take();
+        let solved = match &onward_state {
+            Some(r) => {
+                let label = format!("level {k}'s state where its try before the raise stopped");
+                from_reached(ctx, scene, solver, setup, r, &label, true)
+            }
+            None => solver.solve_from(ctx, scene, start),
+        };
+        collective::agree(&ctx.world, penalty_judged(ctx, setup, target, solved)).map_err(|e| {
+            // What is tried next, in the order of [`remedy`].
+            let tried = Tried {
+                plain_alone: tries == Tries::Plain,
+                raisable,
+                from_try_state: onward_state.is_some(),
+                last_resorts,
+                zone_retry: self.zone_retry == Some(k),
+            };
+            let remedy = remedy(&Failure::of(ctx, &e), &tried);
+            Failed::Refined(e, remedy)
+        })
+    }
+
+    /// After a failed solve of level `k` on `setup`: what is tried next. [`Step::On`]: the
+    /// level again, its failed try's time counted; [`Step::Again`]: the level again, with
+    /// nothing to count; [`Step::Done`]: the run's end.
+    fn remedied(&mut self, scene: &Scene, setup: Setup, failed: Failed, k: usize) -> Step<()> {
+        let ctx = self.ctx;
+        match failed {
+            Failed::Earlier(e) => Step::end(Err(e)),
+            // Where the penalty level's mesh does not converge as complementarity, the
+            // penalty level stays and the levels after it solve complementarity from its
+            // pressure.
+            Failed::Again(e) => {
+                let prev = self.previous.as_ref().expect("a level solved again has one before it");
+                if crate::interrupt::agreed() != 0 || !newton_failed(ctx, &e) {
+                    return Step::end(out_of_time(ctx, scene, Some(prev), k, &self.levels, e));
+                }
+                self.again = false;
+                let why =
+                    format!("level {} did not converge as complementarity from its solution with the penalty ({})", k - 1, reason(&e));
+                match prev.marking.as_ref() {
+                    Some(m) => {
+                        ctx.log(format!("accuracy: {why}; the levels after it solve complementarity from its pressure"));
+                        self.next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), m, None, scene.mesh.growth));
+                        Step::On(())
+                    }
+                    // The penalty level was the last one the budget allows.
+                    None => self.short(scene, prev, k, &why),
+                }
+            }
+            Failed::Refined(e, remedy) => {
+                let prev = self.previous.as_ref().expect("a refined level has one before it");
+                match remedy {
+                    Remedy::HalveQuartered => {
+                        ctx.log(format!(
+                            "accuracy: level {k} did not converge by plain Newton on its quartered mesh ({}); again with its {} quartered triangles halved",
+                            reason(&e),
+                            prev.marking.as_ref().map_or(0, |m| m.quartered())
+                        ));
+                        self.halve_quartered = true;
+                    }
+                    Remedy::Raise => {
+                        ctx.log(format!(
+                            "accuracy: level {k} did not converge ({}); again on the same mesh with the gradient-jump factor reynolds.gradient_jump raised from {} to {RAISED_GRADIENT_JUMP} for this level and the ones after",
+                            reason(&e),
+                            scene.reynolds.gradient_jump
+                        ));
+                        self.raised_from = reached(ctx, &e);
+                        self.own.reynolds.gradient_jump = RAISED_GRADIENT_JUMP;
+                    }
+                    Remedy::FromCoarser => {
+                        ctx.log(format!(
+                            "accuracy: level {k} did not converge from its try's state ({}); again from level {}'s state",
+                            reason(&e),
+                            k - 1
+                        ));
+                    }
+                    Remedy::FullLadder => {
+                        ctx.log(format!(
+                            "accuracy: level {k} did not converge ({}); again on the same mesh with the load and speed continuations and the Hertz start",
+                            reason(&e)
+                        ));
+                        self.full_ladder = Some(k);
+                    }
+                    Remedy::ZoneMesh => {
+                        ctx.log(format!(
+                            "accuracy: level {k} did not converge on its goal-oriented mesh ({}); again with level {}'s pressurised zone refined",
+                            reason(&e),
+                            k - 1
+                        ));
+                        let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
+                        let edges = longest_edges(&prev.setup.mesh);
+                        let marked = zone_mark(&pf, &edges);
+                        self.next = Some(NextMesh::halving(Arc::new(next_field(&prev.setup.mesh, &edges, &marked, scene.mesh.growth))));
+                        self.zone_retry = None;
+                    }
+                    Remedy::SpinPole => {
+                        return Step::end(Err(Error::Context {
+                            context: format!(
+                                "accuracy: level {k} (level {} converged on its coarser mesh only, which does not resolve the spin pole; no result written)",
+                                k - 1
+                            ),
+                            source: Box::new(e),
+                        }));
+                    }
+                    Remedy::Short => return self.short(scene, prev, k, &format!("level {k} did not converge ({e})")),
+                    Remedy::Stop => return Step::end(out_of_time(ctx, scene, Some(prev), k, &self.levels, e)),
+                }
+                Step::On(())
+            }
+            // A first mesh too coarse for the film (at low speed or high load the side
+            // lobes and the outlet constriction are narrower than 0.25 a, and the film
+            // closes there on it: cases/hard/slow, heavy-3gpa) is refined in the Hertz
+            // zone and, finer, around the radii where the film closed, and solved again
+            // without the gradient-jump term ([`without_gradient_jump`]); a film that
+            // closes at a spin pole closes on any mesh.
+            // Every rank decides the same: only Newton's own failure (the same on every
+            // rank) is retried, not one rank's local fault.
+            Failed::First(e) => {
+                if !(crate::interrupt::agreed() == 0 && self.first_retries < FIRST_LEVEL_RETRIES && newton_failed(ctx, &e)) {
+                    return Step::end(Err(e));
+                }
+                let why = format!("did not converge on its mesh ({})", reason(&e));
+                let closed = closures(ctx, &e);
+                self.next = Some(NextMesh::halving(first_level_again(ctx, &setup.mesh, scene.mesh.growth, &why, &closed)));
+                if !closed.is_empty() {
+                    without_gradient_jump(ctx, &mut self.own);
+                }
+                self.first_retries += 1;
+                let further = |r: &Reached| !matches!(&self.from, Some(Onward::Reached(_, f)) if f.t >= r.t);
+                if let Some(r) = reached(ctx, &e).filter(further) {
+                    self.from = Some(Onward::Reached(setup, r));
+                }
+                Step::On(())
+            }
+        }
+    }
+
+    /// Step 4, with the adjoints that serve step 2: the record of the level just solved
+    /// (films, friction, peak memory), its estimate and log line, and the next level's
+    /// marking unless it is the last.
+    fn record(
+        &mut self,
+        scene: &Scene,
+        setup: &Setup,
+        solver: &EhlSolver<'_>,
+        sol: &EhlSolution,
+        fields: &FieldsOnFace,
+        t0: Instant,
+    ) -> Result<LevelEnd, Error> {
+        let (ctx, acc, target) = (self.ctx, self.acc, self.acc.target);
+        let k = self.levels.len();
+        let st = fields.stats();
         let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
         let edges = longest_edges(&setup.mesh);
         let min_size = edges.iter().cloned().fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
         // The pass's adapted rule is kept for the friction goals' gradient below.
-        let friction = level_friction(ctx, scene, &fields)?;
+        let friction = level_friction(ctx, scene, fields)?;
         // A level solved again takes the place of the one before it: its cut and halvings.
-        let replaced = levels.last().filter(|_| again);
+        let replaced = self.levels.last().filter(|_| self.again);
         let level = Level {
-            elastic_unknowns: n_u,
-            pressure_unknowns: n_p,
+            elastic_unknowns: setup.layout.counts().0,
+            pressure_unknowns: setup.layout.counts().1,
             contact_triangles: setup.mesh.contact_tris.len(),
             min_size,
             newton_iterations: sol.newton_total,
-            seconds: tried_s + t0.elapsed().as_secs_f64(),
-            failed_seconds: tried_s,
+            seconds: self.tried_s + t0.elapsed().as_secs_f64(),
+            failed_seconds: self.tried_s,
             hc: st.hc * hs,
             hm: st.hm * hs,
             hm_at: st.hm_at,
             pmax: st.pmax * ph,
             friction: friction.as_ref().map(|f| [f.fx, f.fz]),
             est: None,
-            cut: replaced.map_or_else(|| cut.take(), |l| l.cut),
+            cut: replaced.map_or_else(|| self.cut.take(), |l| l.cut),
             halvings: match replaced {
                 Some(l) => l.halvings,
                 None if k == 0 => 1,
-                None => next.as_ref().map_or(1, |m| m.halvings),
+                None => self.next.as_ref().map_or(1, |m| m.halvings),
             },
             // Set below, once the slopes are known.
             penalty: None,
-            again: std::mem::take(&mut again),
+            again: std::mem::take(&mut self.again),
             marked: None,
             peak_memory_mb: collective::max_f64(&ctx.world, crate::output::peak_since_mb()),
         };
-        over.clear();
-        levels.push(level);
+        self.over.clear();
+        self.levels.push(level);
         if k == 0 && acc.max_seconds > 0.0 {
             // The budget covers the levels after the first: a run always has a result.
             crate::interrupt::set_deadline(Some(ctx.start + std::time::Duration::from_secs_f64(acc.max_seconds)));
         }
         // A level cut to the budget is the last: the level after it would refine the rest of
         // its marking and more, over the budget, and would not be cut again.
-        let cut_level = levels.last().is_some_and(|l| l.cut.is_some());
-        // Refinements so far: a level solved again on its mesh is none.
-        let refined = k - levels.iter().filter(|l| l.again).count();
-        let may_go_on = refined < max_levels && !cut_level;
+        let cut_level = self.levels.last().is_some_and(|l| l.cut.is_some());
+        let may_go_on = self.refined() < acc.max_levels as usize && !cut_level;
         // One adjoint LU serves the next level's marking, the speed exponents when asked for,
         // and the values' slopes in the cavitation penalty, which estimate the penalty's own
         // error: on every level that has an estimate (the second on), also the last, and on
         // the first when it marks anyway.
+        let penalised = scene.effects.cavitation == CavitationModel::Penalty;
         let slopes_wanted = k >= 1 && penalised;
         // Without the penalty the estimate needs no slopes: a level it already takes below
         // the target is the last, and its marking is not needed.
-        let certifies = certifies(&levels);
-        let settled =
-            !penalised && refined >= 2 && certifies && Estimate::of(&levels).is_some_and(|e| e.values().iter().all(|&v| v < target));
+        let certifies = certifies(&self.levels);
+        let below = |est: Option<Estimate>| est.is_some_and(|e| e.values().iter().all(|&v| v < target));
+        let settled = !penalised && self.refined() >= 2 && certifies && below(Estimate::of(&self.levels));
         let goal = may_go_on && acc.marking > 0.0 && !settled;
         let mut adjoint = (goal || slopes_wanted || scene.output.speed_exponents)
             .then(|| collective::agree(&ctx.world, solver.adjoint(ctx, scene, &sol.x)));
         let goals_of = match &adjoint {
             Some(Ok(a)) if goal || slopes_wanted => {
-                Some(collective::agree(&ctx.world, goals(ctx, scene, a, &fields, &st, friction.as_ref())))
+                Some(collective::agree(&ctx.world, goals(ctx, scene, a, fields, &st, friction.as_ref())))
             }
             Some(Err(e)) => Some(Err(Error::numerical(format!("the adjoint failed: {e}")))),
             _ => None,
@@ -802,63 +996,63 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
             .map_err(|e| ctx.log(format!("accuracy: the films' slopes in the cavitation penalty were not computed ({e}); its part of the estimate is from the staged films alone, where there are two")))
             .ok()
             .flatten();
-        levels.last_mut().expect("the level just pushed").penalty =
-            penalty_of(&setup, &sol, [st.hc, st.hm], slopes, scene.reynolds.penalty);
-        let est = Estimate::of(&levels);
-        let level = levels.last_mut().expect("the level just pushed");
+        self.levels.last_mut().expect("the level just pushed").penalty =
+            penalty_of(setup, sol, [st.hc, st.hm], slopes, scene.reynolds.penalty);
+        let est = Estimate::of(&self.levels);
+        let level = self.levels.last_mut().expect("the level just pushed");
         level.est = est;
         ctx.log(level.log_line(k));
-        let reached = refined >= 2 && certifies && est.is_some_and(|e| e.values().iter().all(|&v| v < target));
+        let reached = self.refined() >= 2 && certifies && below(est);
         let last = reached || !may_go_on;
         let exponents = match (&mut adjoint, scene.output.speed_exponents) {
-            (Some(Ok(a)), true) => Some(collective::agree(&ctx.world, super::sensitivity::speed_exponents(ctx, a, &fields, &st))),
+            (Some(Ok(a)), true) => Some(collective::agree(&ctx.world, super::sensitivity::speed_exponents(ctx, a, fields, &st))),
             (Some(Err(e)), true) => Some(Err(Error::numerical(format!("the adjoint failed: {e}")))),
             _ => None,
         };
         let exponents = exponents.map(|got| super::sensitivity::report(ctx, got));
         let fz_target = friction.is_some() && !setup.half;
         let quarter = quarters(est.as_ref(), target, fz_target, sol.continued);
-        let marked = if !last {
+        let marking = if !last {
             // A failed adjoint or goal costs this level's goal-oriented marking, not the run
             // (an interruption is acted on at the check after the marking).
             Some(match goals_of.filter(|_| goal) {
                 Some(Ok(goals)) => {
-                    zone_retry = Some(k + 1);
-                    goal_mark(ctx, scene, &fields, &goals, &edges, acc.marking, quarter)
+                    self.zone_retry = Some(k + 1);
+                    goal_mark(ctx, scene, fields, &goals, &edges, acc.marking, quarter)
                 }
                 Some(Err(e)) => {
                     ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
-                    Marking::unranked(zone_mark(&fields, &edges))
+                    Marking::unranked(zone_mark(fields, &edges))
                 }
-                None => Marking::unranked(zone_mark(&fields, &edges)),
+                None => Marking::unranked(zone_mark(fields, &edges)),
             })
         } else {
             None
         };
         drop(adjoint);
         // A level's time includes its adjoint and the marking of the next one.
-        let pushed = levels.last_mut().expect("the level just pushed");
-        pushed.seconds = tried_s + t0.elapsed().as_secs_f64();
-        pushed.marked = marked.as_ref().map(|m| m.count());
-        tried_s = 0.0;
-        let condensation_s = solver.condensation_s;
-        drop(fields);
-        drop(solver);
-        let mut here = Solved {
-            setup,
-            sol,
-            hc: st.hc,
-            condensation_s,
-            exponents,
-            gradient_jump: scene.reynolds.gradient_jump,
-            cavitation: scene.effects.cavitation,
-            marking: marked,
-            mesh_from: next.clone(),
-            friction,
-        };
+        let pushed = self.levels.last_mut().expect("the level just pushed");
+        pushed.seconds = self.tried_s + t0.elapsed().as_secs_f64();
+        pushed.marked = marking.as_ref().map(|m| m.count());
+        self.tried_s = 0.0;
+        Ok(LevelEnd { marking, friction, exponents, edges, reached })
+    }
+
+    /// Refinements so far: a level solved again on its mesh is none.
+    fn refined(&self) -> usize {
+        self.levels.len().saturating_sub(1) - self.levels.iter().filter(|l| l.again).count()
+    }
+
+    /// Steps 4, 6 and 7 after a level: the run ends at the target or a limit, or the
+    /// level's mesh is solved again as complementarity, or the next level's mesh is made
+    /// from the marking (widened when too few triangles would make it).
+    fn after(&mut self, scene: &Scene, recorded: Recorded, k: usize) -> Step<()> {
+        let (ctx, acc, target) = (self.ctx, self.acc, self.acc.target);
+        let Recorded { mut here, edges, reached } = recorded;
+        let est = self.levels.last().and_then(|l| l.est);
         if reached {
             ctx.log(format!("accuracy: target {target} reached at level {k}"));
-            return finish(ctx, scene, &here, target, &levels, None);
+            return Step::end(finish(ctx, scene, &here, target, &self.levels, None));
         }
         // The mesh's refinement cannot take the penalty's own error below the target: a
         // penalty part above a quarter of it, once the mesh's part is below it, has this
@@ -866,10 +1060,10 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
         // condition as complementarity, which has no such part. In the estimate the level
         // solved again takes this one's place (docs/accuracy.md, "Complementarity where it
         // dominates").
-        let in_the_way = levels.last().and_then(|l| l.penalty.filter(|p| penalty_in_the_way(p, l.est.as_ref(), target)));
-        if let Some(p) = in_the_way.filter(|_| own.effects.cavitation == CavitationModel::Penalty) {
+        let in_the_way = self.levels.last().and_then(|l| l.penalty.filter(|p| penalty_in_the_way(p, l.est.as_ref(), target)));
+        if let Some(p) = in_the_way.filter(|_| self.own.effects.cavitation == CavitationModel::Penalty) {
             if let Err(e) = crate::interrupt::check("adaptive refinement") {
-                return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
+                return Step::end(out_of_time(ctx, scene, Some(&here), k + 1, &self.levels, e));
             }
             let why = format!(
                 "the cavitation penalty's part of the estimate (hc {:.3} %, hm {:.3} %{}) is above a quarter of the target, the mesh's part below it",
@@ -877,54 +1071,53 @@ pub fn run(ctx: &Context, scene: &Scene, earlier: Option<&super::restart::Earlie
                 100.0 * p.hm,
                 p.friction.map_or(String::new(), |[fx, fz]| format!(", fx {:.3} %, fz {:.3} %", 100.0 * fx, 100.0 * fz)),
             );
-            to_complementarity(ctx, &mut own, k, &why);
-            next = here.mesh_from.clone();
-            again = true;
-            previous = Some(here);
-            continue;
+            to_complementarity(ctx, &mut self.own, k, &why);
+            self.next = here.mesh_from.clone();
+            self.again = true;
+            self.previous = Some(here);
+            return Step::Again;
         }
+        let (refined, max_levels) = (self.refined(), acc.max_levels as usize);
+        let short = |why: String| Step::end(finish(ctx, scene, &here, target, &self.levels, Some(short_of(target, &why, k, est))));
         if refined >= max_levels {
-            let why = short_of(target, &format!("accuracy.max_levels = {max_levels} refinement levels solved"), k, est);
-            return finish(ctx, scene, &here, target, &levels, Some(why));
+            return short(format!("accuracy.max_levels = {max_levels} refinement levels solved"));
         }
-        if cut_level {
-            let why = match levels.last().and_then(|l| l.cut).map(|c| c.by) {
-                Some(Budget::Seconds) => {
-                    format!(
-                        "level {k} was cut to the time left of accuracy.max_seconds = {} s: the level after it would not end in it",
-                        acc.max_seconds
-                    )
+        // A level cut to the budget is the last (see `record`).
+        if let Some(c) = self.levels.last().and_then(|l| l.cut) {
+            return short(match c.by {
+                Budget::Seconds => format!(
+                    "level {k} was cut to the time left of accuracy.max_seconds = {} s: the level after it would not end in it",
+                    acc.max_seconds
+                ),
+                Budget::Memory => format!("level {k} was cut to the memory a rank may reach: the level after it would need more"),
+                Budget::Unknowns => {
+                    format!("level {k} was cut to accuracy.max_unknowns = {}: the level after it would exceed it", acc.max_unknowns)
                 }
-                Some(Budget::Memory) => {
-                    format!("level {k} was cut to the memory a rank may reach: the level after it would need more")
-                }
-                _ => format!("level {k} was cut to accuracy.max_unknowns = {}: the level after it would exceed it", acc.max_unknowns),
-            };
-            return finish(ctx, scene, &here, target, &levels, Some(short_of(target, &why, k, est)));
+            });
         }
         let marking = here.marking.as_ref().expect("marked when the loop goes on");
         if !marking.marked.iter().any(|&m| m) {
-            let why = short_of(target, &format!("every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"), k, est);
-            return finish(ctx, scene, &here, target, &levels, Some(why));
+            return short(format!("every contact triangle is at the smallest size {MIN_ADAPTIVE_SIZE} a"));
         }
-        let marked_next = NextMesh::marked(&here.setup.mesh, &edges, marking, None, growth);
+        let marked_next = NextMesh::marked(&here.setup.mesh, &edges, marking, None, scene.mesh.growth);
         // The next level may end the run (it is the second refinement or later): a marking
         // of a few triangles, too small for its change to certify it, is widened now, while
         // the level is one solve and not two ([`FEW_MARKED`]).
         if refined >= 1 {
             let marking = here.marking.as_mut().expect("marked when the loop goes on");
             match widened(ctx, scene, &here.setup.mesh, &edges, marking, marked_next, k) {
-                Ok(wide) => next = Some(wide),
-                Err(e) => return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e),
+                Ok(wide) => self.next = Some(wide),
+                Err(e) => return Step::end(out_of_time(ctx, scene, Some(&here), k + 1, &self.levels, e)),
             }
-            levels.last_mut().expect("the level just pushed").marked = Some(marking.count());
+            self.levels.last_mut().expect("the level just pushed").marked = Some(marking.count());
         } else {
-            next = Some(marked_next);
+            self.next = Some(marked_next);
         }
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
-            return out_of_time(ctx, scene, Some(&here), k + 1, &levels, e);
+            return Step::end(out_of_time(ctx, scene, Some(&here), k + 1, &self.levels, e));
         }
-        previous = Some(here);
+        self.previous = Some(here);
+        Step::On(())
     }
 }
 
