@@ -43,6 +43,9 @@
 //!    it solve complementarity too. In the estimate's
 //!    sequence that level takes the penalty level's place, the coarser levels counted less
 //!    the penalty's error it measured (`estimate::sequence`).
+mod level;
+mod remedy;
+
 use super::estimate::{penalty_in_the_way, Estimate, PenaltyError, PenaltySlopes, SHORT_PENALTY_SHARE};
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::{post_point, PointResult, Setup};
@@ -59,7 +62,9 @@ use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, Ramp
 use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
 use crate::friction::pass::FrictionResult;
-use serde_json::json;
+use level::accuracy_report;
+pub use level::{Budget, Cut, Level};
+use remedy::{newton_failed, remedy, Failure, Remedy, Tried};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -101,98 +106,6 @@ const MAX_WIDENINGS: usize = 5;
 /// unknowns): a cut that still exceeds it is cut again from the meshes tried ([`cut_count`]).
 const MAX_CUTS: usize = 6;
 
-/// One level of the adaptive loop.
-#[derive(Debug, Clone)]
-pub struct Level {
-    pub elastic_unknowns: usize,
-    pub pressure_unknowns: usize,
-    pub contact_triangles: usize,
-    pub min_size: f64,
-    /// Newton iterations of the attempt that converged.
-    pub newton_iterations: usize,
-    /// Wall time of the level: every attempt, its adjoint and the next level's marking.
-    pub seconds: f64,
-    /// The part of `seconds` spent in attempts that did not converge (the level solved
-    /// again on the same or another mesh).
-    pub failed_seconds: f64,
-    /// hc, hm (m), pmax (Pa).
-    pub hc: f64,
-    pub hm: f64,
-    /// Where hm lies (units of a): on a full domain the minimum can move from one side
-    /// lobe to the other between levels.
-    pub hm_at: [f64; 2],
-    pub pmax: f64,
-    /// Friction coefficients fx, fz (scenes with friction).
-    pub friction: Option<[f64; 2]>,
-    /// Estimated errors (None on level 0).
-    pub est: Option<Estimate>,
-    /// How the level was cut to a budget (None: it refined all its marked triangles).
-    pub cut: Option<Cut>,
-    /// How many halvings of the level before its finest refinement made: 2 where that
-    /// level's marking quartered triangles ([`super::marking::QUARTER_RATIO`]), else 1. The
-    /// estimate's crossing guard allows a change to contract by that many steps.
-    pub halvings: u32,
-    /// The cavitation penalty the level was solved at and its estimated error (where the
-    /// penalty was staged, [`super::estimate::PenaltyError`]).
-    pub penalty: Option<PenaltyError>,
-    /// The level is the mesh of the level before it solved again, as complementarity: the
-    /// cavitation penalty's own error stood in the way there
-    /// ([`super::estimate::penalty_in_the_way`]). In the estimate's sequence it takes that
-    /// level's place, and the levels before it count less the penalty's error this one
-    /// measured (`estimate::sequence`).
-    pub again: bool,
-    /// How many triangles the level's marking refines for the next level (after any
-    /// widening; None before it marks, or without a marking).
-    pub marked: Option<usize>,
-    /// The level's peak resident memory per rank, the largest of the ranks (MB), from the
-    /// start of its last attempt to its friction pass (`output::restart_peak`).
-    pub peak_memory_mb: f64,
-}
-
-impl Level {
-    /// The level's unknowns: elastic, pressure and H0.
-    pub fn unknowns(&self) -> usize {
-        self.elastic_unknowns + self.pressure_unknowns + 1
-    }
-
-    /// The log's line of level `k`.
-    fn log_line(&self, k: usize) -> String {
-        format!(
-            "accuracy: level {k}{}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}{}; estimated error {}",
-            if self.again { format!(" (level {}'s mesh as complementarity)", k - 1) } else { String::new() },
-            self.contact_triangles,
-            self.min_size,
-            self.cut.map_or(String::new(), |c| format!(
-                " (cut to the budget {}: {:.0} % of the marked indicator)",
-                c.by.key(),
-                100.0 * c.share
-            )),
-            self.unknowns(),
-            self.newton_iterations,
-            self.seconds,
-            if self.failed_seconds > 0.0 { format!(" ({:.1} s of them in attempts that failed)", self.failed_seconds) } else { String::new() },
-            self.hc,
-            self.hm,
-            self.hm_at[0],
-            self.hm_at[1],
-            self.pmax,
-            self.friction.map_or(String::new(), |f| format!(", fx = {:.5e}, fz = {:.5e}", f[0], f[1])),
-            self.penalty.filter(|p| p.short()).map_or(String::new(), |p| format!(" (cavitation penalty xi = {:.3e}, short of the scene's {:e})", p.xi, p.scene_xi)),
-            self.est.map_or("- (first level)".to_string(), |e| e.describe())
-        )
-    }
-}
-
-/// A level cut to a budget: it refined the `count` marked triangles of largest indicator,
-/// which carry `share` of the marked indicator, because all of them would have exceeded
-/// the budget `by`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Cut {
-    pub count: usize,
-    pub share: f64,
-    pub by: Budget,
-}
-
 /// The cut a level over its budget leads to, before it is decided: the marking it refines
 /// a part of (`marked` triangles), the meshes tried for it with the last one over the
 /// budget (count refined, unknowns), and the `count` of largest indicator to refine with
@@ -215,27 +128,6 @@ impl<'a> PlannedCut<'a> {
         tried.push((cut.map_or(marked, |c| c.count), n));
         let count = cut_count(before, &tried, budget);
         Some(PlannedCut { marking, marked, tried, count, share: marking.indicator_share(count) })
-    }
-}
-
-/// The budget a level is cut to: `accuracy.max_unknowns`, the unknowns the time left of
-/// `accuracy.max_seconds` allows, or those the memory a rank may reach holds
-/// ([`super::memory`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Budget {
-    Unknowns,
-    Seconds,
-    Memory,
-}
-
-impl Budget {
-    /// The scene key or option that sets it.
-    pub fn key(self) -> &'static str {
-        match self {
-            Budget::Unknowns => "accuracy.max_unknowns",
-            Budget::Seconds => "accuracy.max_seconds",
-            Budget::Memory => "-ehl_memory_per_rank",
-        }
     }
 }
 
@@ -1227,121 +1119,6 @@ fn solve_again<'a>(ctx: &'a Context, scene: &Scene, solver: &EhlSolver<'a>, prev
     solver.solve_from(ctx, scene, start)
 }
 
-/// How a refined level's solve failed, the same on every rank.
-#[derive(Debug, Clone, Copy, Default)]
-struct Failure {
-    /// A signal or the spent time budget stopped it.
-    interrupted: bool,
-    /// Newton's own failure, not at a spin pole ([`newton_failed`]).
-    newton: bool,
-    /// The film closed next to a spin pole inside the Hertz circle ([`at_spin_pole`]).
-    at_pole: bool,
-}
-
-impl Failure {
-    /// Collective.
-    fn of(ctx: &Context, e: &Error) -> Self {
-        if crate::interrupt::agreed() != 0 {
-            return Failure { interrupted: true, ..Failure::default() };
-        }
-        Failure { interrupted: false, newton: newton_failed(ctx, e), at_pole: at_spin_pole(ctx, e) }
-    }
-}
-
-/// What the failed solve of a refined level had tried, and what is left for it.
-#[derive(Debug, Clone, Copy)]
-struct Tried {
-    /// Plain Newton alone, on a mesh made by quartering.
-    plain_alone: bool,
-    /// The gradient-jump factor can still be raised.
-    raisable: bool,
-    /// The solve went on from the furthest state of the try before the raise.
-    from_try_state: bool,
-    /// The load and speed continuations and the Hertz start were among its tries.
-    last_resorts: bool,
-    /// The level is goal-oriented and may be meshed again with the pressurised zone.
-    zone_retry: bool,
-}
-
-/// What a refined level that did not converge is tried with next.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Remedy {
-    /// The level meshed again with its quartered triangles halved, which converged by
-    /// plain Newton where the quartered level needed the continuation and the raise (a
-    /// traction drive at L = 22: 62 s to a tighter target against 638 s, docs/practice.md).
-    HalveQuartered,
-    /// The same mesh with the gradient-jump factor raised, for it and the levels after: at
-    /// M = 100, L = 20 the outlet spike is one element wide on the 0.0625 and 0.03125 a
-    /// levels, Newton moves it from node to node, and the alpha ramp stops at 55-63 of
-    /// 68.3 GPa^-1; with c_J = 1 every level converges and hc, hm move by 0.1 %, 0.3 %
-    /// (docs/accuracy.md, "Newton on fine levels at high M and L").
-    Raise,
-    /// The raised solve from the try's furthest state failed: again from the coarser
-    /// level's state.
-    FromCoarser,
-    /// A film that closes next to a spin pole inside the Hertz circle closes on every finer
-    /// mesh: the coarser level converged only because its elements do not resolve the
-    /// pole, so its film is no result (no retry, nothing written). The full ladder after
-    /// such a failure spent 500 s and more closing the film at the same node
-    /// (docs/accuracy.md, "The loop", step 1).
-    SpinPole,
-    /// The same mesh with the load and speed continuations and the Hertz start.
-    FullLadder,
-    /// A goal-oriented level meshed again with the coarser level's whole pressurised zone
-    /// refined, once: at M = 100, L = 20 the continuation stalled at alpha 62.6 of
-    /// 68.3 GPa^-1 on the goal-oriented 0.125 a level and converged on the zone's.
-    ZoneMesh,
-    /// Nothing is left: the last converged level is the result, labelled as short of its
-    /// target.
-    Short,
-    /// An interruption: the run stops (with the last converged level when the time budget
-    /// was spent).
-    Stop,
-}
-
-/// The remedy for a failed refined level, in order: the halved mesh for a quartered one,
-/// the raised gradient-jump factor while it can be raised, the coarser level's state after
-/// a raised solve from the try's state, then (for any failure but a spin pole's) the last
-/// resorts, the zone's mesh, and the last converged level. The raise comes before the last
-/// resorts: at M = 100, L = 20 those cost 330 s on level 3 and never converged from a
-/// coarser level's pressure.
-fn remedy(failed: &Failure, tried: &Tried) -> Remedy {
-    match *failed {
-        Failure { interrupted: true, .. } => Remedy::Stop,
-        Failure { newton: true, .. } if tried.plain_alone => Remedy::HalveQuartered,
-        Failure { newton: true, .. } if tried.raisable => Remedy::Raise,
-        Failure { newton: true, .. } if tried.from_try_state => Remedy::FromCoarser,
-        Failure { at_pole: true, .. } => Remedy::SpinPole,
-        _ if !tried.last_resorts => Remedy::FullLadder,
-        _ if tried.zone_retry => Remedy::ZoneMesh,
-        _ => Remedy::Short,
-    }
-}
-
-/// Whether `e` is Newton's own failure, the same on every rank (not one rank's local
-/// fault), and not a film closing at a spin pole (which closes on any mesh): the failures
-/// after which a level is solved again. Collective.
-fn newton_failed(ctx: &Context, e: &Error) -> bool {
-    collective::all(&ctx.world, newton_failure(e) && !closed_at_spin_pole(e))
-}
-
-/// Whether Newton failed on every rank because the film closed next to a spin pole inside
-/// the Hertz circle, where the model has no film on any mesh. Collective.
-fn at_spin_pole(ctx: &Context, e: &Error) -> bool {
-    collective::all(&ctx.world, closed_at_spin_pole(e))
-}
-
-/// Whether `e` is Newton's own failure (not converged, or the film closed on the way).
-fn newton_failure(e: &Error) -> bool {
-    matches!(e.root(), Error::NotConverged { .. } | Error::FilmClosed { .. })
-}
-
-/// Whether `e` is Newton's failure with the film closed next to a spin pole inside the
-/// Hertz circle (the driver's diagnosis, in its message).
-fn closed_at_spin_pole(e: &Error) -> bool {
-    newton_failure(e) && e.to_string().contains(crate::ehl::driver::POLE_COLLAPSE)
-}
-
 /// The cavitation penalty's estimated error on a level's films `films` (hc, hm), from its
 /// state at the staged penalty where the penalty was staged, and from the values' slopes
 /// in xi where the adjoints gave them (`slopes`; a scene's penalty `scene_xi` that was not
@@ -1510,60 +1287,9 @@ fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Le
     })
 }
 
-/// The `accuracy` object of summary.json: target, estimates, levels.
-fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> serde_json::Value {
-    let last = levels.last().expect("a level");
-    let mut report = json!({
-        "target": target,
-        "reached": shortfall.is_none(),
-        "estimator": format!("change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change; each adds the cavitation penalty's own error c xi^(-p) of values converging like q_inf + c xi^(-p): |d ln q / d ln xi| / p with the slope from the value's adjoint, p from the slope and the change from the staged penalty xi = 1e3 (0.1 to 1; {} where the penalty was not staged; fx and fz at the slower of hc's and hm's orders); a level solved again as complementarity on the mesh of the level before takes that level's place in the sequence, the coarser levels' values shifted by the penalty error measured between the two", super::estimate::ASSUMED_PENALTY_ORDER),
-        "levels": levels.iter().enumerate().map(|(k, l)| {
-            let mut v = json!({
-                "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
-                "contact_triangles": l.contact_triangles, "smallest_size_a": l.min_size,
-                "newton_iterations": l.newton_iterations, "seconds": l.seconds, "failed_attempts_seconds": l.failed_seconds,
-                "halvings": l.halvings, "hc_m": l.hc, "hm_m": l.hm, "hm_at_a": l.hm_at, "pmax_pa": l.pmax,
-                "peak_memory_per_rank_mb": l.peak_memory_mb,
-            });
-            // The first level has no estimate: the key is left out (summary.json holds no null).
-            if let Some(e) = l.est {
-                v["estimated_error"] = e.json();
-            }
-            if let Some([fx, fz]) = l.friction {
-                v["fx"] = json!(fx);
-                v["fz"] = json!(fz);
-            }
-            if let Some(c) = l.cut {
-                v["budget_share"] = json!(c.share);
-                v["cut_by"] = json!(c.by.key());
-            }
-            if let Some(p) = l.penalty {
-                v["penalty"] = p.json();
-            }
-            // The mesh of the level before, solved again as complementarity.
-            if l.again {
-                v["complementarity_on_the_mesh_of_level"] = json!(k - 1);
-            }
-            v
-        }).collect::<Vec<_>>(),
-    });
-    if let Some(e) = last.est {
-        report["estimated_error"] = e.json();
-    }
-    if let Some(why) = shortfall {
-        report["not_reached_because"] = json!(why);
-    }
-    report
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ehl::driver::POLE_COLLAPSE;
-
-    fn closed(message: String) -> Error {
-        Error::FilmClosed { message, closed: vec![[0.0, -0.75]], reached: None }
-    }
 
     #[test]
     fn a_level_that_refined_little_of_the_face_does_not_certify_itself() {
@@ -1600,46 +1326,5 @@ mod tests {
         let cut = Cut { count: 10, share: 0.5, by: Budget::Unknowns };
         assert!(certifies(&[level(965), Level { cut: Some(cut), ..level(1000) }]));
         assert!(!certifies(&[level(720)]));
-    }
-
-    #[test]
-    fn a_failed_level_gets_the_cheapest_remedy_left() {
-        let newton = Failure { newton: true, ..Failure::default() };
-        let everything = Tried { plain_alone: true, raisable: true, from_try_state: true, last_resorts: false, zone_retry: true };
-        assert_eq!(remedy(&newton, &everything), Remedy::HalveQuartered);
-        let raisable = Tried { plain_alone: false, ..everything };
-        assert_eq!(remedy(&newton, &raisable), Remedy::Raise);
-        let raised = Tried { raisable: false, ..raisable };
-        assert_eq!(remedy(&newton, &raised), Remedy::FromCoarser);
-        let from_coarser = Tried { from_try_state: false, ..raised };
-        assert_eq!(remedy(&newton, &from_coarser), Remedy::FullLadder);
-        let ladder_tried = Tried { last_resorts: true, ..from_coarser };
-        assert_eq!(remedy(&newton, &ladder_tried), Remedy::ZoneMesh);
-        assert_eq!(remedy(&newton, &Tried { zone_retry: false, ..ladder_tried }), Remedy::Short);
-        // A film closed at a spin pole is no Newton failure to retry: no raise, no ladder.
-        let pole = Failure { at_pole: true, ..Failure::default() };
-        assert_eq!(remedy(&pole, &everything), Remedy::SpinPole);
-        // A failure outside Newton gets only the last resorts and the zone's mesh.
-        let other = Failure::default();
-        assert_eq!(remedy(&other, &everything), Remedy::FullLadder);
-        assert_eq!(remedy(&other, &ladder_tried), Remedy::ZoneMesh);
-        // An interruption is never retried.
-        let stopped = Failure { interrupted: true, newton: true, at_pole: false };
-        assert_eq!(remedy(&stopped, &everything), Remedy::Stop);
-    }
-
-    #[test]
-    fn only_newtons_failure_at_a_spin_pole_stops_the_refinement() {
-        // The driver's diagnosis of a film closed next to a pole inside the Hertz circle,
-        // bare and as a level's context adds it.
-        let pole = closed(format!("film closed at (0.000, -0.750)a; the film closes at (0.000, -0.750)a, {POLE_COLLAPSE} (0, -0.633)a"));
-        assert!(closed_at_spin_pole(&pole) && newton_failure(&pole));
-        let wrapped = Error::Context { context: "level 1".into(), source: Box::new(pole) };
-        assert!(closed_at_spin_pole(&wrapped));
-        // A film closed at a side lobe is refined and solved again.
-        let lobe = closed("film closed at (0.250, -0.875)a after 7 iterations".into());
-        assert!(newton_failure(&lobe) && !closed_at_spin_pole(&lobe));
-        // Words alone are not Newton's failure.
-        assert!(!closed_at_spin_pole(&Error::Numerical(format!("{POLE_COLLAPSE} (0, -0.6)a"))));
     }
 }

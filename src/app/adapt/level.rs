@@ -1,0 +1,163 @@
+//! What the adaptive loop records of each level, and the `accuracy` report of summary.json
+//! made from it.
+use crate::app::estimate::{Estimate, PenaltyError};
+use serde_json::json;
+
+/// One level of the adaptive loop.
+#[derive(Debug, Clone)]
+pub struct Level {
+    pub elastic_unknowns: usize,
+    pub pressure_unknowns: usize,
+    pub contact_triangles: usize,
+    pub min_size: f64,
+    /// Newton iterations of the attempt that converged.
+    pub newton_iterations: usize,
+    /// Wall time of the level: every attempt, its adjoint and the next level's marking.
+    pub seconds: f64,
+    /// The part of `seconds` spent in attempts that did not converge (the level solved
+    /// again on the same or another mesh).
+    pub failed_seconds: f64,
+    /// hc, hm (m), pmax (Pa).
+    pub hc: f64,
+    pub hm: f64,
+    /// Where hm lies (units of a): on a full domain the minimum can move from one side
+    /// lobe to the other between levels.
+    pub hm_at: [f64; 2],
+    pub pmax: f64,
+    /// Friction coefficients fx, fz (scenes with friction).
+    pub friction: Option<[f64; 2]>,
+    /// Estimated errors (None on level 0).
+    pub est: Option<Estimate>,
+    /// How the level was cut to a budget (None: it refined all its marked triangles).
+    pub cut: Option<Cut>,
+    /// How many halvings of the level before its finest refinement made: 2 where that
+    /// level's marking quartered triangles ([`crate::app::marking::QUARTER_RATIO`]), else 1. The
+    /// estimate's crossing guard allows a change to contract by that many steps.
+    pub halvings: u32,
+    /// The cavitation penalty the level was solved at and its estimated error (where the
+    /// penalty was staged, [`crate::app::estimate::PenaltyError`]).
+    pub penalty: Option<PenaltyError>,
+    /// The level is the mesh of the level before it solved again, as complementarity: the
+    /// cavitation penalty's own error stood in the way there
+    /// ([`crate::app::estimate::penalty_in_the_way`]). In the estimate's sequence it takes that
+    /// level's place, and the levels before it count less the penalty's error this one
+    /// measured (`estimate::sequence`).
+    pub again: bool,
+    /// How many triangles the level's marking refines for the next level (after any
+    /// widening; None before it marks, or without a marking).
+    pub marked: Option<usize>,
+    /// The level's peak resident memory per rank, the largest of the ranks (MB), from the
+    /// start of its last attempt to its friction pass (`output::restart_peak`).
+    pub peak_memory_mb: f64,
+}
+
+impl Level {
+    /// The level's unknowns: elastic, pressure and H0.
+    pub fn unknowns(&self) -> usize {
+        self.elastic_unknowns + self.pressure_unknowns + 1
+    }
+
+    /// The log's line of level `k`.
+    pub(super) fn log_line(&self, k: usize) -> String {
+        format!(
+            "accuracy: level {k}{}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}{}; estimated error {}",
+            if self.again { format!(" (level {}'s mesh as complementarity)", k - 1) } else { String::new() },
+            self.contact_triangles,
+            self.min_size,
+            self.cut.map_or(String::new(), |c| format!(
+                " (cut to the budget {}: {:.0} % of the marked indicator)",
+                c.by.key(),
+                100.0 * c.share
+            )),
+            self.unknowns(),
+            self.newton_iterations,
+            self.seconds,
+            if self.failed_seconds > 0.0 { format!(" ({:.1} s of them in attempts that failed)", self.failed_seconds) } else { String::new() },
+            self.hc,
+            self.hm,
+            self.hm_at[0],
+            self.hm_at[1],
+            self.pmax,
+            self.friction.map_or(String::new(), |f| format!(", fx = {:.5e}, fz = {:.5e}", f[0], f[1])),
+            self.penalty.filter(|p| p.short()).map_or(String::new(), |p| format!(" (cavitation penalty xi = {:.3e}, short of the scene's {:e})", p.xi, p.scene_xi)),
+            self.est.map_or("- (first level)".to_string(), |e| e.describe())
+        )
+    }
+}
+
+/// A level cut to a budget: it refined the `count` marked triangles of largest indicator,
+/// which carry `share` of the marked indicator, because all of them would have exceeded
+/// the budget `by`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cut {
+    pub count: usize,
+    pub share: f64,
+    pub by: Budget,
+}
+
+/// The budget a level is cut to: `accuracy.max_unknowns`, the unknowns the time left of
+/// `accuracy.max_seconds` allows, or those the memory a rank may reach holds
+/// ([`super::memory`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Budget {
+    Unknowns,
+    Seconds,
+    Memory,
+}
+
+impl Budget {
+    /// The scene key or option that sets it.
+    pub fn key(self) -> &'static str {
+        match self {
+            Budget::Unknowns => "accuracy.max_unknowns",
+            Budget::Seconds => "accuracy.max_seconds",
+            Budget::Memory => "-ehl_memory_per_rank",
+        }
+    }
+}
+
+/// The `accuracy` object of summary.json: target, estimates, levels.
+pub(super) fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> serde_json::Value {
+    let last = levels.last().expect("a level");
+    let mut report = json!({
+        "target": target,
+        "reached": shortfall.is_none(),
+        "estimator": format!("change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change; each adds the cavitation penalty's own error c xi^(-p) of values converging like q_inf + c xi^(-p): |d ln q / d ln xi| / p with the slope from the value's adjoint, p from the slope and the change from the staged penalty xi = 1e3 (0.1 to 1; {} where the penalty was not staged; fx and fz at the slower of hc's and hm's orders); a level solved again as complementarity on the mesh of the level before takes that level's place in the sequence, the coarser levels' values shifted by the penalty error measured between the two", crate::app::estimate::ASSUMED_PENALTY_ORDER),
+        "levels": levels.iter().enumerate().map(|(k, l)| {
+            let mut v = json!({
+                "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
+                "contact_triangles": l.contact_triangles, "smallest_size_a": l.min_size,
+                "newton_iterations": l.newton_iterations, "seconds": l.seconds, "failed_attempts_seconds": l.failed_seconds,
+                "halvings": l.halvings, "hc_m": l.hc, "hm_m": l.hm, "hm_at_a": l.hm_at, "pmax_pa": l.pmax,
+                "peak_memory_per_rank_mb": l.peak_memory_mb,
+            });
+            // The first level has no estimate: the key is left out (summary.json holds no null).
+            if let Some(e) = l.est {
+                v["estimated_error"] = e.json();
+            }
+            if let Some([fx, fz]) = l.friction {
+                v["fx"] = json!(fx);
+                v["fz"] = json!(fz);
+            }
+            if let Some(c) = l.cut {
+                v["budget_share"] = json!(c.share);
+                v["cut_by"] = json!(c.by.key());
+            }
+            if let Some(p) = l.penalty {
+                v["penalty"] = p.json();
+            }
+            // The mesh of the level before, solved again as complementarity.
+            if l.again {
+                v["complementarity_on_the_mesh_of_level"] = json!(k - 1);
+            }
+            v
+        }).collect::<Vec<_>>(),
+    });
+    if let Some(e) = last.est {
+        report["estimated_error"] = e.json();
+    }
+    if let Some(why) = shortfall {
+        report["not_reached_because"] = json!(why);
+    }
+    report
+}
