@@ -13,7 +13,8 @@ PETSc options take one dash (or follow '--') and go to PETSc unchanged (PETSC_OP
 Defaults: -ksp_type preonly -pc_type lu; MUMPS (-mat_mumps_icntl_7 4, PORD) for sparse matrices;
   the dense condensed EHL Jacobian: -pc_factor_mat_solver_type scalapack (2+ ranks) or petsc
   (LAPACK, 1 rank); -condensed_mat_type aij -pc_factor_mat_solver_type mumps returns to MUMPS.
-Useful: -log_view, -ksp_view, -options_left (lists options nobody used), -mat_mumps_icntl_4 2.
+Useful: -log_view, -ksp_view, -options_left (lists options nobody used), -mat_mumps_icntl_4 2;
+  -mat_mumps_icntl_22 1 writes MUMPS's factors to disk (/tmp): a fifth less memory, a quarter more time.
 The solver's own options (-ehl_monitor, -ehl_memory_per_rank GB, -ehl_supg_delta, ...) are listed
   with the others by -help after the scene.
 Exit codes: 0 success, 1 solve failed or did not converge, 2 bad command line, scene or output folder

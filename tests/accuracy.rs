@@ -387,6 +387,8 @@ fn a_level_predicted_over_the_memory_is_not_begun_and_the_run_says_so() {
     let log = text(&out);
     assert_eq!(out.status.code(), Some(4), "{log}");
     assert!(log.contains("GB per rank from level 0's peak") && log.contains("(-ehl_memory_per_rank)"), "{log}");
+    // And what else may help: the factors out of core.
+    assert!(log.contains("-mat_mumps_icntl_22 1 puts MUMPS's factors on disk"), "{log}");
     let acc = &s["accuracy"];
     assert_eq!(acc["reached"], false, "{acc}");
     assert!(acc["not_reached_because"].as_str().unwrap().contains("0.1 GB a rank may reach"), "{acc}");
