@@ -343,7 +343,7 @@ impl<'c> Loop<'c> {
     }
 
     /// The run's end with the level before's result, short of the target because of `why`.
-    fn short(&self, scene: &Scene, prev: &Solved, k: usize, why: &str) -> Step<()> {
+    fn short<T>(&self, scene: &Scene, prev: &Solved, k: usize, why: &str) -> Step<T> {
         let why = short_of(self.acc.target, why, k - 1, self.levels.last().and_then(|l| l.est));
         Step::end(finish(self.ctx, scene, prev, self.acc.target, &self.levels, Some(why)))
     }
@@ -515,14 +515,7 @@ impl<'c> Loop<'c> {
             Ok(sol) => sol,
             Err(failed) => {
                 drop(solver);
-                return match self.remedied(scene, setup, failed, k) {
-                    Step::On(()) => {
-                        self.tried_s += t0.elapsed().as_secs_f64();
-                        Step::Again
-                    }
-                    Step::Again => Step::Again,
-                    Step::Done(end) => Step::Done(end),
-                };
+                return self.remedied(scene, setup, failed, k, t0);
             }
         };
         let fields = FieldsOnFace::new(&setup.mesh, &setup.layout, &sol.x);
@@ -545,11 +538,10 @@ impl<'c> Loop<'c> {
             // the same films.
             self.next = Some(NextMesh::halving(first_level_again(ctx, &setup.mesh, scene.mesh.growth, &why, &[])));
             self.first_retries += 1;
-            self.tried_s += t0.elapsed().as_secs_f64();
             drop(fields);
             drop(solver);
             self.from = Some(Onward::Converged(setup, sol.x));
-            return Step::Again;
+            return self.tried_again(t0);
         }
         if unphysical {
             return Step::end(Err(Error::numerical(format!(
@@ -684,10 +676,9 @@ impl<'c> Loop<'c> {
         })
     }
 
-    /// After a failed solve of level `k` on `setup`: what is tried next. [`Step::On`]: the
-    /// level again, its failed try's time counted; [`Step::Again`]: the level again, with
-    /// nothing to count; [`Step::Done`]: the run's end.
-    fn remedied(&mut self, scene: &Scene, setup: Setup, failed: Failed, k: usize) -> Step<()> {
+    /// After a failed solve of level `k` on `setup`, begun at `t0`: what is tried next. The
+    /// level again ([`Step::Again`], the failed try's time counted in it), or the run's end.
+    fn remedied(&mut self, scene: &Scene, setup: Setup, failed: Failed, k: usize, t0: Instant) -> Step<Recorded> {
         let ctx = self.ctx;
         match failed {
             Failed::Earlier(e) => Step::end(Err(e)),
@@ -706,7 +697,7 @@ impl<'c> Loop<'c> {
                     Some(m) => {
                         ctx.log(format!("accuracy: {why}; the levels after it solve complementarity from its pressure"));
                         self.next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), m, None, scene.mesh.growth));
-                        Step::On(())
+                        self.tried_again(t0)
                     }
                     // The penalty level was the last one the budget allows.
                     None => self.short(scene, prev, k, &why),
@@ -770,7 +761,7 @@ impl<'c> Loop<'c> {
                     Remedy::Short => return self.short(scene, prev, k, &format!("level {k} did not converge ({e})")),
                     Remedy::Stop => return Step::end(out_of_time(ctx, scene, Some(prev), k, &self.levels, e)),
                 }
-                Step::On(())
+                self.tried_again(t0)
             }
             // A first mesh too coarse for the film (at low speed or high load the side
             // lobes and the outlet constriction are narrower than 0.25 a, and the film
@@ -795,9 +786,16 @@ impl<'c> Loop<'c> {
                 if let Some(r) = reached(ctx, &e).filter(further) {
                     self.from = Some(Onward::Reached(setup, r));
                 }
-                Step::On(())
+                self.tried_again(t0)
             }
         }
+    }
+
+    /// The level tried again after an attempt begun at `t0` that did not converge: its time
+    /// is part of the level's.
+    fn tried_again<T>(&mut self, t0: Instant) -> Step<T> {
+        self.tried_s += t0.elapsed().as_secs_f64();
+        Step::Again
     }
 
     /// Step 4, with the adjoints that serve step 2: the record of the level just solved
@@ -822,9 +820,10 @@ impl<'c> Loop<'c> {
         let friction = level_friction(ctx, scene, fields)?;
         // A level solved again takes the place of the one before it: its cut and halvings.
         let replaced = self.levels.last().filter(|_| self.again);
+        let (elastic_unknowns, pressure_unknowns) = setup.layout.counts();
         let level = Level {
-            elastic_unknowns: setup.layout.counts().0,
-            pressure_unknowns: setup.layout.counts().1,
+            elastic_unknowns,
+            pressure_unknowns,
             contact_triangles: setup.mesh.contact_tris.len(),
             min_size,
             newton_iterations: sol.newton_total,
