@@ -7,7 +7,10 @@ use super::face_files::{write_face_vtu, write_plots, write_profiles};
 use super::{collective, Context, Outcome};
 use crate::case::{FrictionModel, Scene};
 use crate::ehl::driver::{self, EhlSolution, EhlSolver};
-use crate::ehl::{layout::Layout, post::FieldsOnFace};
+use crate::ehl::{
+    layout::Layout,
+    post::{FieldsOnFace, FilmStats},
+};
 use crate::error::{Error, ResultExt};
 use crate::friction::pass::{friction_pass, stress_at, FaceSolution, FrictionResult, FrictionSetup};
 use crate::friction::shear::ShearLaw;
@@ -244,14 +247,56 @@ pub fn post_point(
     dir: &Path,
 ) -> Result<PointResult, Error> {
     let t_post = Instant::now();
-    let (mesh, layout) = (&setup.mesh, &setup.layout);
-    let hertz = scene.hertz();
-    let fields = FieldsOnFace::new(mesh, layout, &sol.x);
+    let fields = FieldsOnFace::new(&setup.mesh, &setup.layout, &sol.x);
     let st = fields.stats();
-    let target = if setup.half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 };
-    let load_error = (st.load - target).abs() / target;
-    // A converged Newton can still hold an unphysical state: never report it as a result.
-    // Every rank holds the whole iterate, so every rank reaches the same verdict.
+    refuse_unphysical(sol, &st)?;
+    let film = report_film(ctx, scene, setup, &fields, &st);
+    let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
+    let fset = friction_setup(scene, setup.mesh.spec.contact);
+    // The pass shares its triangles out over the ranks.
+    let friction = match (&fset, computed) {
+        (Some(fs), None) => Some(friction_pass(&fields, fs, &OverRanks(ctx))?),
+        (Some(_), computed) => computed,
+        (None, _) => None,
+    };
+    let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
+    let mut res = PointResult {
+        hc: st.hc * hs,
+        hm: st.hm * hs,
+        pmax: st.pmax * ph,
+        load_error: film.load_error,
+        fx: None,
+        fz: None,
+        profile_x0: Vec::new(),
+    };
+    if ctx.rank != 0 {
+        return Ok(res);
+    }
+    if let Some(f) = &friction {
+        report_friction(ctx, scene, f);
+        res.fx = Some(f.fx);
+        res.fz = Some(f.fz);
+    }
+    let lines = write_face_outputs(ctx, scene, setup, &fields, fset.as_ref(), friction.as_ref(), dir)?;
+    res.profile_x0 = lines.profile_x0.clone();
+    let subsurface = if scene.output.subsurface {
+        Some(subsurface_point(ctx, scene, setup, &fields, friction.as_ref(), sol, condensation_s, dir)?)
+    } else {
+        None
+    };
+    let post = Post { film, lines, peak, condensation_s, post_s: t_post.elapsed().as_secs_f64() };
+    let mut summary = point_summary(ctx, scene, setup, sol, &st, &post, friction.as_ref())?;
+    if let Some(s) = subsurface {
+        summary["subsurface"] = s;
+        summary["timing"]["subsurface_s"] = summary["subsurface"]["total_s"].clone();
+    }
+    ctx.write_summary_to(dir, &summary)?;
+    Ok(res)
+}
+
+/// A converged Newton can still hold an unphysical state: it is never reported as a result.
+/// Every rank holds the whole iterate, so every rank reaches the same verdict.
+fn refuse_unphysical(sol: &EhlSolution, st: &FilmStats) -> Result<(), Error> {
     if sol.x.iter().any(|v| !v.is_finite()) || ![st.hc, st.hm, st.pmax, st.pmin, st.load].iter().all(|v| v.is_finite()) {
         return Err(Error::numerical("the converged state contains NaN or infinite values; no result written"));
     }
@@ -261,8 +306,25 @@ pub fn post_point(
             st.hm, st.hm_at[0], st.hm_at[1]
         )));
     }
-    let hs = scene.scales().film_scale();
-    let (a, ph) = (hertz.a, hertz.ph);
+    Ok(())
+}
+
+/// What the log says of a point's film, kept for its summary.
+struct FilmReport {
+    /// The relative error of the load balance (the integral of P against its target).
+    load_error: f64,
+    /// The pressure near the inlet's edge (units of p_H), if the face reaches there.
+    inlet: Option<f64>,
+    hd: Option<HamrockDowson>,
+    nvm: Option<f64>,
+}
+
+/// The result's log line, a warning when the inlet cuts off the pressure's build-up, and
+/// the film formulas beside the result.
+fn report_film(ctx: &Context, scene: &Scene, setup: &Setup, fields: &FieldsOnFace, st: &FilmStats) -> FilmReport {
+    let target = if setup.half { std::f64::consts::PI / 3.0 } else { 2.0 * std::f64::consts::PI / 3.0 };
+    let load_error = (st.load - target).abs() / target;
+    let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
     ctx.log(format!(
         "result: hc = {:.4e} m, hm = {:.4e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa, load error {:.2e}",
         st.hc * hs,
@@ -273,60 +335,72 @@ pub fn post_point(
         load_error
     ));
     // How much of the inlet's pressure build-up the domain cuts off.
-    let rect = mesh.spec.contact;
+    let rect = setup.mesh.spec.contact;
     let inlet = fields.at(rect.x0 + INLET_PROBE, 0.0).map(|v| v.0);
     if let Some(w) = inlet.and_then(|p| inlet_warning(p, rect.x0, scene.accuracy.target)) {
         ctx.log(w);
     }
-    // The film formulas, for the log line here and summary.json below.
     let (hd, nvm) = (scene.hamrock_dowson(), scene.nijenbanning_hc());
     if let Some(line) = formulas_line(hd.as_ref(), nvm, st.hc * hs, st.hm * hs) {
         ctx.log(line);
     }
-    let peak = collective::max_f64(&ctx.world, crate::output::peak_rss_mb());
-    let mut res =
-        PointResult { hc: st.hc * hs, hm: st.hm * hs, pmax: st.pmax * ph, load_error, fx: None, fz: None, profile_x0: Vec::new() };
-    let fset = friction_setup(scene, rect);
-    // The pass shares its triangles out over the ranks.
-    let friction = match (&fset, computed) {
-        (Some(fs), None) => Some(friction_pass(&fields, fs, &OverRanks(ctx))?),
-        (Some(_), computed) => computed,
-        (None, _) => None,
-    };
-    if ctx.rank != 0 {
-        return Ok(res);
-    }
-    if let Some(f) = &friction {
+    FilmReport { load_error, inlet, hd, nvm }
+}
+
+/// The friction pass's log line, and a warning where the friction coefficient is not a
+/// lubricated contact's.
+fn report_friction(ctx: &Context, scene: &Scene, f: &FrictionResult) {
+    ctx.log(format!(
+        "friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s; the rule subdivided on {} of {} triangles, {} stress evaluations)",
+        scene.effects.friction,
+        f.fx,
+        f.fz,
+        f.fx_n,
+        f.fz_n,
+        f.tau_max,
+        f.seconds,
+        f.quadrature.subdivided,
+        f.quadrature.triangles,
+        f.quadrature.evaluations
+    ));
+    // A lubricated contact's friction coefficient is of order 0.01-0.1; above 1 the
+    // Newtonian law has carried exp(alpha p) viscosities into shear stresses no
+    // lubricant sustains (the limiting shear stress is what Ree-Eyring adds).
+    if f.fx.hypot(f.fz) > 1.0 {
         ctx.log(format!(
-            "friction ({}): fx = {:.5e}, fz = {:.5e} (Fx = {:.4e} N, Fz = {:.4e} N), max |tau| on the disc {:.4e} Pa ({:.2} s; the rule subdivided on {} of {} triangles, {} stress evaluations)",
+            "warning: the friction coefficient sqrt(fx^2 + fz^2) = {:.3e} is above 1: with effects.friction = \"{}\" the shear stress reaches {:.3e} Pa, far above any lubricant's limiting shear stress; effects.friction = \"ree-eyring\" bounds it",
+            f.fx.hypot(f.fz),
             scene.effects.friction,
-            f.fx,
-            f.fz,
-            f.fx_n,
-            f.fz_n,
-            f.tau_max,
-            f.seconds,
-            f.quadrature.subdivided,
-            f.quadrature.triangles,
-            f.quadrature.evaluations
+            f.tau_max
         ));
-        // A lubricated contact's friction coefficient is of order 0.01-0.1; above 1 the
-        // Newtonian law has carried exp(alpha p) viscosities into shear stresses no
-        // lubricant sustains (the limiting shear stress is what Ree-Eyring adds).
-        if f.fx.hypot(f.fz) > 1.0 {
-            ctx.log(format!(
-                "warning: the friction coefficient sqrt(fx^2 + fz^2) = {:.3e} is above 1: with effects.friction = \"{}\" the shear stress reaches {:.3e} Pa, far above any lubricant's limiting shear stress; effects.friction = \"ree-eyring\" bounds it",
-                f.fx.hypot(f.fz),
-                scene.effects.friction,
-                f.tau_max
-            ));
-        }
-        res.fx = Some(f.fx);
-        res.fz = Some(f.fz);
     }
+}
+
+/// What the centre lines of the face give the summary: the film along X = 0 (z / a, h in
+/// m), and along X = 0 and Z = 0 the largest jump of the pressure slope and the largest
+/// scallop (docs/accuracy.md, "Smooth fields").
+struct CentreLines {
+    profile_x0: Vec<[f64; 2]>,
+    jumps: [f64; 2],
+    wiggles: [f64; 2],
+}
+
+/// The face's files (rank 0): the centre-line profiles (with the shear stresses when
+/// friction is on) and the shear profile, the plots, the VTU and the nodal pressure a later
+/// run can start from (`--start-from`); the smoothness log line.
+fn write_face_outputs(
+    ctx: &Context,
+    scene: &Scene,
+    setup: &Setup,
+    fields: &FieldsOnFace,
+    fset: Option<&FrictionSetup>,
+    friction: Option<&FrictionResult>,
+    dir: &Path,
+) -> Result<CentreLines, Error> {
+    let (hs, a, ph) = (scene.scales().film_scale(), scene.hertz().a, scene.hertz().ph);
     let tau = |x: f64, z: f64| -> Result<Option<[f64; 2]>, Error> {
-        match &fset {
-            Some(fs) => stress_at(&fields, fs, x, z).transpose(),
+        match fset {
+            Some(fs) => stress_at(fields, fs, x, z).transpose(),
             None => Ok(None),
         }
     };
@@ -355,7 +429,6 @@ pub fn post_point(
         wiggles[0].0, wiggles[0].1[1], wiggles[1].0, wiggles[1].1[0]
     ));
     let wiggles = wiggles.map(|w| w.0);
-    res.profile_x0 = prof_x0.iter().map(|r| [r[1] / a, r[3]]).collect();
     let with_tau = friction.is_some();
     write_profiles(dir, "profile_x0.csv", &prof_x0, with_tau)?;
     write_profiles(dir, "profile_z0.csv", &prof_z0, with_tau)?;
@@ -365,27 +438,50 @@ pub fn post_point(
         write_profiles(dir, "shear_profile.csv", &line, true)?;
     }
     if scene.output.png {
-        write_plots(dir, &fields, a, ph, hs, &prof_x0, &prof_z0)?;
-        if let Some(f) = &friction {
+        write_plots(dir, fields, a, ph, hs, &prof_x0, &prof_z0)?;
+        if let Some(f) = friction {
             let zl = scene.output.shear_profile_z / a;
-            super::plots::friction_plots(dir, &fields, f, a, scene.output.shear_profile_z, &profile([r.x0, zl], [r.x1, zl])?)?;
+            super::plots::friction_plots(dir, fields, f, a, scene.output.shear_profile_z, &profile([r.x0, zl], [r.x1, zl])?)?;
         }
         if let Some(k) = scene.kinematics() {
             super::plots::velocity_plots(dir, &k, a, r)?;
         }
     }
     if scene.output.vtu {
-        write_face_vtu(dir, &fields, a, ph, hs, friction.as_ref())?;
+        write_face_vtu(dir, fields, a, ph, hs, friction)?;
     }
-    let subsurface = if scene.output.subsurface {
-        Some(subsurface_point(ctx, scene, setup, &fields, friction.as_ref(), sol, condensation_s, dir)?)
-    } else {
-        None
-    };
     // The nodal pressure a later run can start from (--start-from).
     let face_p = dir.join(super::restart::FACE_PRESSURE);
-    crate::output::write_atomic(&face_p, super::restart::face_pressure_csv(mesh, &|n| fields.p_node(n), a, ph).as_bytes())
+    crate::output::write_atomic(&face_p, super::restart::face_pressure_csv(&setup.mesh, &|n| fields.p_node(n), a, ph).as_bytes())
         .map_err(Error::writing(&face_p))?;
+    Ok(CentreLines { profile_x0: prof_x0.iter().map(|r| [r[1] / a, r[3]]).collect(), jumps, wiggles })
+}
+
+/// What post-processing measured of a point, for its summary.
+struct Post {
+    film: FilmReport,
+    lines: CentreLines,
+    /// The largest peak resident memory of a rank (MB).
+    peak: f64,
+    condensation_s: Option<f64>,
+    post_s: f64,
+}
+
+/// summary.json of one converged point (without its subsurface section).
+fn point_summary(
+    ctx: &Context,
+    scene: &Scene,
+    setup: &Setup,
+    sol: &EhlSolution,
+    st: &FilmStats,
+    post: &Post,
+    friction: Option<&FrictionResult>,
+) -> Result<serde_json::Value, Error> {
+    let (mesh, layout) = (&setup.mesh, &setup.layout);
+    let hertz = scene.hertz();
+    let (hs, a, ph) = (scene.scales().film_scale(), hertz.a, hertz.ph);
+    let (hd, nvm, load_error, inlet) = (post.film.hd.as_ref(), post.film.nvm, post.film.load_error, post.film.inlet);
+    let (jumps, wiggles, peak, condensation_s) = (post.lines.jumps, post.lines.wiggles, post.peak, post.condensation_s);
     let (n_u, n_p) = layout.counts();
     let kin = scene.kinematics().expect("lubricated scene");
     use crate::output::summary::*;
@@ -458,16 +554,16 @@ pub fn post_point(
             mesh_s: setup.mesh_s,
             assembly_s: sol.assembly_s,
             solve_s: sol.solve_s,
-            post_s: Some(t_post.elapsed().as_secs_f64()),
+            post_s: Some(post.post_s),
             total_s: ctx.start.elapsed().as_secs_f64(),
             // Only when the elastic block was condensed (not for rigid solids).
             condensation_s,
-            friction_s: friction.as_ref().map(|f| f.seconds),
+            friction_s: friction.map(|f| f.seconds),
         },
         peak_rss_mb: peak,
         effects: effects_report(scene, setup.half),
         scene: scene.clone(),
-        friction: friction.as_ref().map(|f| FrictionSummary {
+        friction: friction.map(|f| FrictionSummary {
             model: scene.effects.friction.as_str().to_string(),
             fx: f.fx,
             fz: f.fz,
@@ -483,13 +579,7 @@ pub fn post_point(
             }),
         }),
     };
-    let mut summary = to_json(&summary)?;
-    if let Some(s) = subsurface {
-        summary["subsurface"] = s;
-        summary["timing"]["subsurface_s"] = summary["subsurface"]["total_s"].clone();
-    }
-    ctx.write_summary_to(dir, &summary)?;
-    Ok(res)
+    to_json(&summary)
 }
 
 /// The subsurface stresses of one converged point (rank 0, `output.subsurface`): the disc's
