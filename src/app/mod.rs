@@ -143,55 +143,63 @@ pub fn run(world: SimpleCommunicator, opts: RunOptions) -> i32 {
             }
             4
         }
-        Err(e) => {
-            // A failure every rank shares (Newton, an interruption) is printed once, by
-            // rank 0; a rank that failed alone prints its own message.
-            let all_failed = collective::all(&ctx.world, failed_here);
-            // A value of one of the user's PETSc options that PETSc rejected when it read it
-            // (a solver is set up only when it is first used): bad input, named.
-            // The whole database: PETSC_OPTIONS and options files too, not only the command line.
-            let given = crate::petsc::options::given().unwrap_or_else(|_| opts.petsc_args.clone());
-            let quoted = cli::options_quoted(&given, &e.to_string());
-            // The rank that read the option may be alone with PETSc's message (rank 0's
-            // condensation): every rank ends with the same code.
-            let bad_option = !collective::all(&ctx.world, quoted.is_empty());
-            if rank == 0 || (failed_here && !all_failed) {
-                let who = if all_failed { String::new() } else { format!(" (rank {rank})") };
-                if quoted.is_empty() {
-                    eprintln!("ehl-petsc: error{who}: {e}");
-                } else {
-                    eprintln!(
-                        "ehl-petsc: error{who}: PETSc rejects the value of the PETSc option '{}' (PETSc's message follows): {e}",
-                        quoted.join("', '")
-                    );
-                }
-            }
-            match crate::interrupt::agreed() {
-                0 if bad_option => 2,
-                // A spent time budget that nothing turned into a labelled result.
-                0 | crate::interrupt::DEADLINE => 1,
-                sig => 128 + sig,
-            }
-        }
+        Err(e) => failure_code(&ctx, &e, failed_here, &opts.petsc_args),
     };
     if let Some(c) = &claim {
         c.release(code == 0 || code == 4);
     }
     if rank == 0 {
-        // -options_left style: the user's PETSc options that nothing queried (misspelt, or
-        // for a solver this run did not use).
-        match crate::petsc::options::unused() {
-            Ok(left) => {
-                for (name, value) in left {
-                    let v = value.map(|v| format!(" {v}")).unwrap_or_default();
-                    eprintln!("ehl-petsc: warning: PETSc option '{name}{v}' was given but not used by this run (misspelt, or for a solver this run does not use)");
-                }
-            }
-            Err(e) => eprintln!("ehl-petsc: warning: cannot list unused PETSc options: {e}"),
-        }
+        warn_unused_options();
     }
     drop(petsc);
     code
+}
+
+/// The exit code of a run that failed with `e` (`failed_here`: on this rank), after its
+/// message: printed once by rank 0 when every rank failed, by the failing rank when it failed
+/// alone. 2 for a PETSc option whose value PETSc rejected, 128 + the signal for an
+/// interruption, 1 otherwise. Collective.
+fn failure_code(ctx: &Context, e: &Error, failed_here: bool, petsc_args: &[String]) -> i32 {
+    let all_failed = collective::all(&ctx.world, failed_here);
+    // A value of one of the user's PETSc options that PETSc rejected when it read it
+    // (a solver is set up only when it is first used): bad input, named.
+    // The whole database: PETSC_OPTIONS and options files too, not only the command line.
+    let given = crate::petsc::options::given().unwrap_or_else(|_| petsc_args.to_vec());
+    let quoted = cli::options_quoted(&given, &e.to_string());
+    // The rank that read the option may be alone with PETSc's message (rank 0's
+    // condensation): every rank ends with the same code.
+    let bad_option = !collective::all(&ctx.world, quoted.is_empty());
+    if ctx.rank == 0 || (failed_here && !all_failed) {
+        let who = if all_failed { String::new() } else { format!(" (rank {})", ctx.rank) };
+        if quoted.is_empty() {
+            eprintln!("ehl-petsc: error{who}: {e}");
+        } else {
+            eprintln!(
+                "ehl-petsc: error{who}: PETSc rejects the value of the PETSc option '{}' (PETSc's message follows): {e}",
+                quoted.join("', '")
+            );
+        }
+    }
+    match crate::interrupt::agreed() {
+        0 if bad_option => 2,
+        // A spent time budget that nothing turned into a labelled result.
+        0 | crate::interrupt::DEADLINE => 1,
+        sig => 128 + sig,
+    }
+}
+
+/// -options_left style: warns of the user's PETSc options that nothing queried (misspelt,
+/// or for a solver this run did not use). Rank 0.
+fn warn_unused_options() {
+    match crate::petsc::options::unused() {
+        Ok(left) => {
+            for (name, value) in left {
+                let v = value.map(|v| format!(" {v}")).unwrap_or_default();
+                eprintln!("ehl-petsc: warning: PETSc option '{name}{v}' was given but not used by this run (misspelt, or for a solver this run does not use)");
+            }
+        }
+        Err(e) => eprintln!("ehl-petsc: warning: cannot list unused PETSc options: {e}"),
+    }
 }
 
 /// `--check`: reads and checks everything [`run`] would check before solving (the scene
