@@ -10,6 +10,7 @@ pub mod lubricated;
 mod marking;
 mod memory;
 pub mod plots;
+pub mod point;
 pub mod restart;
 mod sensitivity;
 pub mod study;

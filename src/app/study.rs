@@ -12,7 +12,8 @@
 //! - `ring`: the scene's own mesh with the ring `mesh.ring_inner <= r <= mesh.ring_outer`
 //!   (around the Hertz circle, where the inlet build-up, the side lobes and the outlet
 //!   spike sit) refined to h = 0.125, 0.0625, 0.03125, ...
-use super::lubricated::{post_point, PointResult, Setup};
+use super::lubricated::Setup;
+use super::point::{post_point, PointResult};
 use super::{collective, Context};
 use crate::case::Scene;
 use crate::ehl::driver::EhlSolver;

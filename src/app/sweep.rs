@@ -17,7 +17,8 @@
 //! PNG plots of the film and the friction against the swept parameters.
 use super::adapt::Adapted;
 use super::estimate::Estimate;
-use super::lubricated::{post_point, PointResult, Setup};
+use super::lubricated::Setup;
+use super::point::{post_point, PointResult};
 use super::{collective, Context, Outcome};
 use crate::case::Scene;
 use crate::ehl::driver::EhlSolver;

@@ -48,12 +48,13 @@ mod remedy;
 
 use super::estimate::{penalty_in_the_way, Estimate, PenaltyError, PenaltySlopes, SHORT_PENALTY_SHARE};
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
-use super::lubricated::{post_point, PointResult, Setup};
+use super::lubricated::Setup;
 use super::marking::{
     cut_count, goal_mark, goals, longest_edges, next_field, quarters, widened_count, zone_mark, Marking, NextMesh, TimeLeft,
     MIN_BUDGET_SHARE,
 };
 use super::memory::{self, MemoryLeft};
+use super::point::{post_point, PointResult};
 use super::{Context, Outcome};
 use crate::case::schema::{Accuracy, RAISED_GRADIENT_JUMP};
 use crate::case::{CavitationModel, Scene};
