@@ -165,9 +165,10 @@ fn the_complementarity_film_is_the_limit_of_the_penalty_films() {
 /// - The level solved again has the penalty level's unknowns and no penalty part, its hm
 ///   lies above the penalty's and its pmax below (as in
 ///   `the_complementarity_film_is_the_limit_of_the_penalty_films`).
-/// - Its estimate is the penalty level's less the penalty's part: in the estimate's
-///   sequence it takes that level's place, the coarser levels counted less the penalty
-///   error it measured. The two scales differ by that error (2 % at most), so 3 % of the
+/// - Its estimate is the penalty level's less the penalty's part, plus the part of its
+///   change from the penalty solution that the penalty's estimate does not explain: in the
+///   estimate's sequence it takes that level's place, the coarser levels counted less the
+///   change it measured. The two scales differ by that change (2 % at most), so 3 % of the
 ///   estimate is allowed.
 /// - The films are within the target plus 1 % (the models' difference: clamped cube
 ///   against half-space) of the independent multigrid solution, hc 0.4595 um and
@@ -194,7 +195,9 @@ fn a_penalty_in_the_way_has_its_level_solved_again_as_complementarity() {
     for q in ["hc", "hm"] {
         let e = again["estimated_error"][q].as_f64().unwrap();
         let mesh = pen["estimated_error"][q].as_f64().unwrap() - pen["penalty"]["estimated_error"][q].as_f64().unwrap();
-        assert!((e / mesh - 1.0).abs() < 0.03, "{q}: {e} against the penalty level's mesh part {mesh}");
+        let gap = again["change_from_penalty_beyond_its_estimate"][q].as_f64().unwrap_or_else(|| panic!("{again}"));
+        assert!(gap >= 0.0, "{again}");
+        assert!((e / (mesh + gap) - 1.0).abs() < 0.03, "{q}: {e} against the penalty level's mesh part {mesh} and the gap {gap}");
         assert!(e < 0.02, "{acc}");
     }
     let (hc, hm) = (s["film"]["hc_m"].as_f64().unwrap(), s["film"]["hm_m"].as_f64().unwrap());
@@ -229,8 +232,9 @@ fn a_cut_level_kept_out_by_the_penalty_alone_is_solved_as_complementarity() {
     assert_eq!(levels[2]["pressure_unknowns"], levels[1]["pressure_unknowns"], "{acc}");
     for q in ["hc", "hm"] {
         let mesh = levels[1]["estimated_error"][q].as_f64().unwrap() - levels[1]["penalty"]["estimated_error"][q].as_f64().unwrap();
+        let gap = levels[2]["change_from_penalty_beyond_its_estimate"][q].as_f64().unwrap_or_else(|| panic!("{acc}"));
         let e = levels[2]["estimated_error"][q].as_f64().unwrap();
-        assert!((e / mesh - 1.0).abs() < 0.03, "{q}: {e} against {mesh}");
+        assert!((e / (mesh + gap) - 1.0).abs() < 0.03, "{q}: {e} against {mesh} and the gap {gap}");
     }
     let last = &levels[3];
     assert!(last["budget_share"].as_f64().is_some() && last.get("penalty").is_none(), "{last}");

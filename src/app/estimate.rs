@@ -264,6 +264,10 @@ pub struct Estimate {
     pub penalty: Option<[f64; 2]>,
     /// The cavitation penalty's part of fx and fz.
     pub friction_penalty: Option<[f64; 2]>,
+    /// On a level solved again as complementarity: the part of each value's change from the
+    /// penalty solution of its mesh (hc, hm, fx, fz) that the penalty's estimated error there
+    /// does not explain ([`models_gap`]).
+    pub models_gap: Option<[f64; 4]>,
 }
 
 impl Estimate {
@@ -283,8 +287,10 @@ impl Estimate {
         let [pc, pm] = penalty.unwrap_or_default();
         let friction_penalty = p.and_then(|p| p.friction).filter(|_| e.len() == 4);
         let [px, pz] = friction_penalty.unwrap_or_default();
-        let friction = (e.len() == 4).then(|| [e[2] + px, e[3] + pz]);
-        Some(Estimate { hc: e[0] + pc, hm: e[1] + pm, friction, penalty, friction_penalty })
+        let models_gap = models_gap(levels);
+        let [gc, gm, gx, gz] = models_gap.unwrap_or_default();
+        let friction = (e.len() == 4).then(|| [e[2] + px + gx, e[3] + pz + gz]);
+        Some(Estimate { hc: e[0] + pc + gc, hm: e[1] + pm + gm, friction, penalty, friction_penalty, models_gap })
     }
 
     /// Whether a level cut to the budget after the last of `levels` could bring every
@@ -344,6 +350,17 @@ impl Estimate {
             }
             s.push(')');
         }
+        if let Some([gc, gm, gx, gz]) = self.models_gap {
+            s.push_str(&format!(
+                " (the change from the penalty solution of this mesh beyond the penalty's estimate: hc {:.3} %, hm {:.3} %",
+                100.0 * gc,
+                100.0 * gm
+            ));
+            if self.friction.is_some() {
+                s.push_str(&format!(", fx {:.3} %, fz {:.3} %", 100.0 * gx, 100.0 * gz));
+            }
+            s.push(')');
+        }
         s
     }
 
@@ -354,6 +371,18 @@ impl Estimate {
             v["fz"] = json!(fz);
         }
         v
+    }
+
+    /// The models' gap ([`models_gap`]) as summary.json gives it, on a level solved again
+    /// as complementarity.
+    pub(super) fn models_gap_json(&self) -> Option<serde_json::Value> {
+        let [hc, hm, fx, fz] = self.models_gap?;
+        let mut v = json!({ "hc": hc, "hm": hm });
+        if self.friction.is_some() {
+            v["fx"] = json!(fx);
+            v["fz"] = json!(fz);
+        }
+        Some(v)
     }
 }
 
@@ -389,6 +418,50 @@ fn sequence(levels: &[Level], q: impl Fn(&Level) -> Option<f64>) -> Option<Vec<f
         seq.push(v);
     }
     Some(seq)
+}
+
+/// The part of a value's change `d` from its penalty solution to the complementarity
+/// solution of the same mesh (relative) that the penalty's estimated error `e` (relative,
+/// at least 0) cannot explain: complementarity is the penalty's limit in xi only up to the
+/// two discretisations' own difference, which the estimate's sequence would otherwise count
+/// as the penalty's error ([`sequence`]). The penalty's limit lies on the side its slope
+/// `slope` (d ln q / d ln xi) points to: a change to the other side is all unexplained;
+/// otherwise, or with no slope, what exceeds `e`. Measured on fixed meshes (docs/accuracy.md,
+/// "The two cavitation models on one mesh"), the difference falls with the mesh, so it is
+/// at most one level's change of the complementarity sequence.
+pub fn unexplained_by_penalty(d: f64, e: f64, slope: Option<f64>) -> f64 {
+    match slope.filter(|s| *s != 0.0) {
+        Some(s) if s * d < 0.0 => d.abs(),
+        _ => (d.abs() - e).max(0.0),
+    }
+}
+
+/// On a level solved again as complementarity ([`Level::again`]), each value's
+/// ([`unexplained_by_penalty`]) part of its change from the penalty level before it (hc, hm
+/// relative to themselves; fx, fz to the friction coefficient's magnitude; 0 where a value
+/// is absent). The estimate's sequence shifts the coarser levels by the whole change, as if
+/// it were the penalty's error alone; what the penalty's estimate does not explain is the
+/// two models' own difference on that mesh (or a penalty error above its estimate), and is
+/// added to the estimate. A penalty level without a record explains nothing.
+fn models_gap(levels: &[Level]) -> Option<[f64; 4]> {
+    let [.., pen, again] = levels else { return None };
+    if !again.again {
+        return None;
+    }
+    let p = pen.penalty;
+    let slopes = p.and_then(|p| p.slope);
+    let rel = |a: f64, b: f64, scale: f64| if scale > 0.0 { (a - b) / scale } else { 0.0 };
+    let hc = unexplained_by_penalty(rel(again.hc, pen.hc, again.hc.abs()), p.map_or(0.0, |p| p.hc), slopes.map(|s| s.films[0]));
+    let hm = unexplained_by_penalty(rel(again.hm, pen.hm, again.hm.abs()), p.map_or(0.0, |p| p.hm), slopes.map(|s| s.films[1]));
+    let [fx, fz] = match (again.friction, pen.friction) {
+        (Some(a), Some(b)) => {
+            let e = p.and_then(|p| p.friction).unwrap_or_default();
+            let s = slopes.and_then(|s| s.friction);
+            [0, 1].map(|i| unexplained_by_penalty(rel(a[i], b[i], a[0].hypot(a[1])), e[i], s.map(|s| s[i])))
+        }
+        _ => [0.0; 2],
+    };
+    Some([hc, hm, fx, fz])
 }
 
 /// Each target value's sequence over `levels` ([`sequence`]) with the scale its error is
@@ -633,6 +706,7 @@ mod tests {
             friction: None,
             penalty: Some([p.hc, p.hm]),
             friction_penalty: None,
+            models_gap: None,
         };
         let p = at(1e4, 7.5e-4);
         assert!(penalty_in_the_way(&p, Some(&est(&p)), 0.001));
@@ -668,6 +742,8 @@ mod tests {
         let pen = |i: i32| level(comp(i), comp(i) + 0.003, Some([f(i) + 5e-4, 1e-4]));
         let mut levels: Vec<Level> = (0..4).map(pen).collect();
         levels[3].halvings = 2;
+        // Its record explains the change: hm's 0.3 % and fx's 1 % of the coefficient.
+        levels[3].penalty = Some(PenaltyError { friction: Some([0.0101, 0.0]), ..penalty_at(1e4, 1e4, 0.0031) });
         let mut again = level(comp(3), comp(3), Some([f(3), 1e-4]));
         // The loop gives it the halvings of the level it replaces.
         again.again = true;
@@ -690,6 +766,43 @@ mod tests {
         levels.push(level(comp(4), comp(4), Some([f(4), 1e-4])));
         clean.push(level(comp(4), comp(4), Some([f(4), 1e-4])));
         assert_eq!(Estimate::of(&levels).map(|e| e.values()), Estimate::of(&clean).map(|e| e.values()));
+    }
+
+    #[test]
+    fn a_change_to_complementarity_beyond_the_penalty_s_estimate_is_added() {
+        // A penalty level 0.3 % below in hm (its limit above: positive slope) and an
+        // unchanged hc, then its mesh solved again as complementarity.
+        let comp = |i: i32| 1.0 + 0.04 * 0.25f64.powi(i);
+        let mut levels: Vec<Level> = (0..3).map(|i| level(comp(i), comp(i) - 0.003, None)).collect();
+        let mut again = level(comp(2), comp(2), None);
+        again.again = true;
+        let with = |levels: &mut Vec<Level>, hm_part: f64, slope: Option<f64>| {
+            let p =
+                PenaltyError { slope: slope.map(|s| PenaltySlopes { films: [0.0, s], friction: None }), ..penalty_at(1e4, 1e4, hm_part) };
+            levels[2].penalty = Some(p);
+            let mut all = levels.clone();
+            all.push(again.clone());
+            Estimate::of(&all).unwrap()
+        };
+        let d = 0.003 / comp(2);
+        // Explained by a part at least as large: nothing added, the mesh's estimate alone.
+        let explained = with(&mut levels, 0.004, Some(1e-3));
+        assert_eq!(explained.models_gap, Some([0.0; 4]));
+        // Half explained: the rest is added to hm's estimate and shown.
+        let half = with(&mut levels, 0.5 * d, Some(1e-3));
+        assert!((half.models_gap.unwrap()[1] - 0.5 * d).abs() < 1e-15);
+        assert!((half.hm - explained.hm - 0.5 * d).abs() < 1e-15);
+        assert!(half.describe().contains("beyond the penalty's estimate: hc 0.000 %, hm 0.150 %"), "{}", half.describe());
+        assert_eq!(half.models_gap_json().unwrap()["hm"], half.models_gap.unwrap()[1]);
+        // A slope pointing the other way explains none of it; no slope leaves the excess.
+        assert!((with(&mut levels, 0.004, Some(-1e-3)).models_gap.unwrap()[1] - d).abs() < 1e-15);
+        assert!((with(&mut levels, 0.5 * d, None).models_gap.unwrap()[1] - 0.5 * d).abs() < 1e-15);
+        // Only on the level solved again.
+        assert_eq!(Estimate::of(&levels).unwrap().models_gap, None);
+        // The pure rule.
+        assert_eq!(unexplained_by_penalty(0.002, 0.003, None), 0.0);
+        assert!((unexplained_by_penalty(-0.002, 0.0005, Some(-1e-4)) - 0.0015).abs() < 1e-15);
+        assert_eq!(unexplained_by_penalty(-0.002, 0.0005, Some(1e-4)), 0.002);
     }
 
     #[test]

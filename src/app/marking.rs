@@ -797,10 +797,10 @@ mod tests {
     #[test]
     fn a_level_quarters_only_far_from_the_target_after_plain_newton_and_without_fz() {
         // table2-ue2's level 2 at target 0.01: estimates 16 % and 43 %, plain Newton.
-        let far = Estimate { hc: 0.16, hm: 0.43, friction: None, penalty: None, friction_penalty: None };
+        let far = Estimate { hc: 0.16, hm: 0.43, friction: None, penalty: None, friction_penalty: None, models_gap: None };
         assert!(quarters(Some(&far), 0.01, false, false));
         // Its level 3 at 0.18 % and 0.47 %: within 4 times the target, one halving ahead.
-        let near = Estimate { hc: 0.0018, hm: 0.0047, friction: None, penalty: None, friction_penalty: None };
+        let near = Estimate { hc: 0.0018, hm: 0.0047, friction: None, penalty: None, friction_penalty: None, models_gap: None };
         assert!(!quarters(Some(&near), 0.01, false, false));
         // ... and more than one at target 0.002, where the budget of 2 ranks binds: halving.
         assert!(!quarters(Some(&near), 0.002, false, false));
@@ -809,10 +809,10 @@ mod tests {
         // among the targets, halves.
         assert!(!quarters(None, 0.01, false, false));
         assert!(!quarters(Some(&far), 0.01, false, true));
-        let spin = Estimate { hc: 0.05, hm: 0.05, friction: Some([0.01, 0.2]), penalty: None, friction_penalty: None };
+        let spin = Estimate { hc: 0.05, hm: 0.05, friction: Some([0.01, 0.2]), penalty: None, friction_penalty: None, models_gap: None };
         assert!(!quarters(Some(&spin), 0.01, true, false));
         // One estimate far off is enough (fx among them).
-        let fx = Estimate { hc: 0.001, hm: 0.001, friction: Some([0.05, 0.0]), penalty: None, friction_penalty: None };
+        let fx = Estimate { hc: 0.001, hm: 0.001, friction: Some([0.05, 0.0]), penalty: None, friction_penalty: None, models_gap: None };
         assert!(quarters(Some(&fx), 0.01, false, false));
     }
 }

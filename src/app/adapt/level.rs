@@ -122,7 +122,7 @@ pub(super) fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&
     let mut report = json!({
         "target": target,
         "reached": shortfall.is_none(),
-        "estimator": format!("change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change; each adds the cavitation penalty's own error c xi^(-p) of values converging like q_inf + c xi^(-p): |d ln q / d ln xi| / p with the slope from the value's adjoint, p from the slope and the change from the staged penalty xi = 1e3 (0.1 to 1; {} where the penalty was not staged; fx and fz at the slower of hc's and hm's orders); a level solved again as complementarity on the mesh of the level before takes that level's place in the sequence, the coarser levels' values shifted by the penalty error measured between the two", crate::app::estimate::ASSUMED_PENALTY_ORDER),
+        "estimator": format!("change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change; each adds the cavitation penalty's own error c xi^(-p) of values converging like q_inf + c xi^(-p): |d ln q / d ln xi| / p with the slope from the value's adjoint, p from the slope and the change from the staged penalty xi = 1e3 (0.1 to 1; {} where the penalty was not staged; fx and fz at the slower of hc's and hm's orders); a level solved again as complementarity on the mesh of the level before takes that level's place in the sequence, the coarser levels' values shifted by the change measured between the two, and adds the part of that change the penalty's estimate does not explain (the two models' own difference on the mesh)", crate::app::estimate::ASSUMED_PENALTY_ORDER),
         "levels": levels.iter().enumerate().map(|(k, l)| {
             let mut v = json!({
                 "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
@@ -134,6 +134,9 @@ pub(super) fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&
             // The first level has no estimate: the key is left out (summary.json holds no null).
             if let Some(e) = l.est {
                 v["estimated_error"] = e.json();
+                if let Some(g) = e.models_gap_json() {
+                    v["change_from_penalty_beyond_its_estimate"] = g;
+                }
             }
             if let Some([fx, fz]) = l.friction {
                 v["fx"] = json!(fx);
