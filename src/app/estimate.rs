@@ -278,7 +278,8 @@ impl Estimate {
         // that kept nearly all of it is a level of the sequence ([`FULL_LEVEL_SHARE`]).
         let cut = levels.last().is_some_and(|l| l.cut.is_some_and(|c| c.share < FULL_LEVEL_SHARE));
         let halvings = halvings(levels);
-        let e = sequences(levels)
+        let seqs = sequences(levels);
+        let e = seqs
             .iter()
             .map(|(q, scale)| if cut { estimate_after_cut(q, &halvings, *scale) } else { estimate_scaled(q, &halvings, *scale) })
             .collect::<Option<Vec<f64>>>()?;
@@ -287,7 +288,7 @@ impl Estimate {
         let [pc, pm] = penalty.unwrap_or_default();
         let friction_penalty = p.and_then(|p| p.friction).filter(|_| e.len() == 4);
         let [px, pz] = friction_penalty.unwrap_or_default();
-        let models_gap = models_gap(levels);
+        let models_gap = models_gap(levels, &seqs.iter().map(|(_, scale)| *scale).collect::<Vec<_>>());
         let [gc, gm, gx, gz] = models_gap.unwrap_or_default();
         let friction = (e.len() == 4).then(|| [e[2] + px + gx, e[3] + pz + gz]);
         Some(Estimate { hc: e[0] + pc + gc, hm: e[1] + pm + gm, friction, penalty, friction_penalty, models_gap })
@@ -437,31 +438,33 @@ pub fn unexplained_by_penalty(d: f64, e: f64, slope: Option<f64>) -> f64 {
 }
 
 /// On a level solved again as complementarity ([`Level::again`]), each value's
-/// ([`unexplained_by_penalty`]) part of its change from the penalty level before it (hc, hm
-/// relative to themselves; fx, fz to the friction coefficient's magnitude; 0 where a value
-/// is absent). The estimate's sequence shifts the coarser levels by the whole change, as if
-/// it were the penalty's error alone; what the penalty's estimate does not explain is the
-/// two models' own difference on that mesh (or a penalty error above its estimate), and is
-/// added to the estimate. A penalty level without a record explains nothing.
-fn models_gap(levels: &[Level]) -> Option<[f64; 4]> {
+/// ([`unexplained_by_penalty`]) part of its change from the penalty level before it,
+/// relative to the value's `scales` ([`sequences`]: hc and hm their own, fx and fz the
+/// friction coefficient's magnitude; 0 where a value has none). The estimate's sequence
+/// shifts the coarser levels by the whole change, as if it were the penalty's error alone;
+/// what the penalty's estimate does not explain is the two models' own difference on that
+/// mesh (or a penalty error above its estimate), and is added to the estimate. A penalty
+/// level without a record explains nothing.
+fn models_gap(levels: &[Level], scales: &[f64]) -> Option<[f64; 4]> {
     let [.., pen, again] = levels else { return None };
     if !again.again {
         return None;
     }
-    let p = pen.penalty;
-    let slopes = p.and_then(|p| p.slope);
-    let rel = |a: f64, b: f64, scale: f64| if scale > 0.0 { (a - b) / scale } else { 0.0 };
-    let hc = unexplained_by_penalty(rel(again.hc, pen.hc, again.hc.abs()), p.map_or(0.0, |p| p.hc), slopes.map(|s| s.films[0]));
-    let hm = unexplained_by_penalty(rel(again.hm, pen.hm, again.hm.abs()), p.map_or(0.0, |p| p.hm), slopes.map(|s| s.films[1]));
-    let [fx, fz] = match (again.friction, pen.friction) {
-        (Some(a), Some(b)) => {
-            let e = p.and_then(|p| p.friction).unwrap_or_default();
-            let s = slopes.and_then(|s| s.friction);
-            [0, 1].map(|i| unexplained_by_penalty(rel(a[i], b[i], a[0].hypot(a[1])), e[i], s.map(|s| s[i])))
+    // Each value's estimated penalty error and slope, in the order of `scales`.
+    let parts = pen.penalty.map_or(vec![], |p| p.parts());
+    let slopes = pen.penalty.and_then(|p| p.slope).map_or(vec![], |s| {
+        let mut v = s.films.to_vec();
+        v.extend(s.friction.iter().flatten());
+        v
+    });
+    let value = |l: &Level, i: usize| if i < 2 { Some([l.hc, l.hm][i]) } else { l.friction.map(|f| f[i - 2]) };
+    let mut gap = [0.0; 4];
+    for (i, &scale) in scales.iter().enumerate().filter(|&(_, &scale)| scale > 0.0) {
+        if let (Some(a), Some(b)) = (value(again, i), value(pen, i)) {
+            gap[i] = unexplained_by_penalty((a - b) / scale, parts.get(i).copied().unwrap_or(0.0), slopes.get(i).copied());
         }
-        _ => [0.0; 2],
-    };
-    Some([hc, hm, fx, fz])
+    }
+    Some(gap)
 }
 
 /// Each target value's sequence over `levels` ([`sequence`]) with the scale its error is
