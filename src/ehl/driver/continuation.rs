@@ -822,11 +822,9 @@ impl<'a> Path<'a> {
         {
             report = self.nw.on_with_l2(&self.base, system, short, &report)?;
         }
-        if report.converged {
-            self.state = Some(self.nw.solution()?);
+        if self.settle(report)? {
             self.continued = false;
         }
-        self.last = Some(report);
         Ok(())
     }
 
@@ -963,10 +961,7 @@ impl<'a> Path<'a> {
                 r.reason,
                 r.iterations
             ));
-            if r.converged {
-                self.state = Some(self.nw.solution()?);
-            }
-            self.last = Some(r);
+            self.settle(r)?;
         }
         self.staged_penalty = base_x.map(|base_x| {
             let mid = self.nw.trail.take().unwrap_or_default().into_iter().rfind(|(s, _)| *s < t).map(|(s, x)| (xi * s, x));
@@ -989,11 +984,19 @@ impl<'a> Path<'a> {
             "cavitation as complementarity, from the penalty solution at xi = {:e}: {} ({} iterations)",
             self.relaxed.reynolds.penalty, r.reason, r.iterations
         ));
-        if r.converged {
+        self.settle(r)?;
+        Ok(())
+    }
+
+    /// A solve's report becomes the path's last, and its solution the path's state when it
+    /// converged; returns whether it did.
+    fn settle(&mut self, report: SolveReport) -> Result<bool, Error> {
+        let converged = report.converged;
+        if converged {
             self.state = Some(self.nw.solution()?);
         }
-        self.last = Some(r);
-        Ok(())
+        self.last = Some(report);
+        Ok(converged)
     }
 
     /// The converged state with the path that reached it, or the error naming the path
