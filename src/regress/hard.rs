@@ -3,8 +3,10 @@
 //! everywhere and a load error below 1e-6. The pair is, by default, the scene at an
 //! accuracy target and at a quarter of it: both must reach their targets, and hc, hm may
 //! move less than the target between them (the error of the run at the target, measured
-//! against a run four times more accurate). A mesh pair (`ci/hard -m plain`) may move hc
-//! and hm by less than 2 %.
+//! against a run four times more accurate); so may fx and fz where they are targets, relative
+//! to the friction coefficient's magnitude sqrt(fx^2 + fz^2), the scale of their estimates
+//! (fz vanishes without spin). A mesh pair (`ci/hard -m plain`) may move hc and hm by less
+//! than 2 %.
 
 use serde_json::Value;
 
@@ -153,6 +155,14 @@ pub fn check_case(name: &str, default: &Run, refined: &Run, change: f64) -> (Str
         }
         _ => (None, None),
     };
+    let fmoves = friction_moves(default, refined);
+    if let Some(moves) = fmoves {
+        for (name, v) in ["fx", "fz"].iter().zip(moves) {
+            if !(v.abs() < change) {
+                failed.push(format!("{name} moves {:+.2} % of the friction coefficient between the pair", 100.0 * v));
+            }
+        }
+    }
     let m = default.summary.as_ref().or(refined.summary.as_ref()).and_then(|s| num(s, "moes.M"));
     let pair = |f: &dyn Fn(&Key) -> String| {
         format!("{} / {}", keys[0].as_ref().map(f).unwrap_or("-".into()), keys[1].as_ref().map(f).unwrap_or("-".into()))
@@ -169,7 +179,7 @@ pub fn check_case(name: &str, default: &Run, refined: &Run, change: f64) -> (Str
         }
     };
     let row = format!(
-        "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} / {:.0} | {} |\n",
+        "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} / {:.0} | {} |\n",
         m.map(|m| format!("{m:.0}")).unwrap_or("-".into()),
         keys.iter().map(|k| if k.is_some() { "yes" } else { "NO" }).collect::<Vec<_>>().join(" / "),
         pair(&|k| format!("{:.0}", k.its)),
@@ -178,6 +188,7 @@ pub fn check_case(name: &str, default: &Run, refined: &Run, change: f64) -> (Str
         pair(&|k| format!("{:.4}", k.hm * 1e6)),
         pct(dhc),
         pct(dhm),
+        fmoves.map(|[x, z]| format!("{}, {}", pct(Some(x)), pct(Some(z)))).unwrap_or("-".into()),
         worst(&|k| k.pmin_ph, true),
         worst(&|k| k.load_error, false),
         default.wall_s,
@@ -187,8 +198,22 @@ pub fn check_case(name: &str, default: &Run, refined: &Run, change: f64) -> (Str
     (row, failed)
 }
 
+/// How far fx and fz move from the refined run to the default one, relative to the refined
+/// run's friction coefficient sqrt(fx^2 + fz^2): where both runs estimated them as targets
+/// (`accuracy.estimated_error.fx`), else None (a mesh pair, or no friction).
+fn friction_moves(default: &Run, refined: &Run) -> Option<[f64; 2]> {
+    let values = |run: &Run| {
+        let s = run.summary.as_ref()?;
+        num(s, "accuracy.estimated_error.fx")?;
+        Some([num(s, "friction.fx")?, num(s, "friction.fz")?])
+    };
+    let (d, r) = (values(default)?, values(refined)?);
+    let scale = r[0].hypot(r[1]);
+    (scale > 0.0).then(|| [(d[0] - r[0]) / scale, (d[1] - r[1]) / scale])
+}
+
 /// Header of the hard suite's table.
-pub const HEADER: &str = "| case | M | converged (default / refined) | Newton its | continuation steps | hc (um) | hm (um) | hc change | hm change | min nodal p / p_H | max load error | wall (s) | verdict |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+pub const HEADER: &str = "| case | M | converged (default / refined) | Newton its | continuation steps | hc (um) | hm (um) | hc change | hm change | fx, fz change (of the friction coefficient) | min nodal p / p_H | max load error | wall (s) | verdict |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
 
 #[cfg(test)]
 mod tests {
@@ -250,6 +275,29 @@ mod tests {
         short.summary.as_mut().unwrap()["accuracy"] = json!({"reached": false, "not_reached_because": "the time budget"});
         let (row, f) = check_case("t", &run(3.0e-7, 1.0e-7, 0.0), &short, 0.01);
         assert_eq!(f, ["refined: target not reached (the time budget)"], "{row}");
+    }
+
+    #[test]
+    fn a_target_pair_checks_fx_and_fz_against_the_friction_coefficient() {
+        let with_friction = |fx: f64, fz: f64| {
+            let mut r = run(3.0e-7, 1.0e-7, 0.0);
+            let s = r.summary.as_mut().unwrap();
+            s["friction"] = json!({"fx": fx, "fz": fz});
+            s["accuracy"] = json!({"reached": true, "estimated_error": {"hc": 0.001, "hm": 0.001, "fx": 0.001, "fz": 0.001}});
+            r
+        };
+        // fz is small next to fx: its move is measured against sqrt(fx^2 + fz^2) = 4.12e-3,
+        // so a move of 3e-5 (3 % of fz itself) is 0.73 % of the coefficient and passes at 1 %.
+        let (row, f) = check_case("spin", &with_friction(4.0e-3, -1.03e-3), &with_friction(4.0e-3, -1.0e-3), 0.01);
+        assert!(f.is_empty(), "{f:?}");
+        assert!(row.contains("| +0.00 %, -0.73 % |"), "{row}");
+        let (_, f) = check_case("spin", &with_friction(4.0e-3 * 1.02, -3.0e-3), &with_friction(4.0e-3, -3.0e-3), 0.01);
+        assert_eq!(f, ["fx moves +1.60 % of the friction coefficient between the pair"]);
+        // Without friction among the estimated values (a mesh pair's runs) it is not checked.
+        let mut plain = with_friction(4.0e-3 * 1.5, 0.0);
+        plain.summary.as_mut().unwrap().as_object_mut().unwrap().remove("accuracy");
+        let (_, f) = check_case("mesh", &plain, &with_friction(4.0e-3, 0.0), MESH_CHANGE);
+        assert!(f.is_empty(), "{f:?}");
     }
 
     #[test]
