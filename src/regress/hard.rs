@@ -42,6 +42,8 @@ struct Key {
     load_error: f64,
     its: f64,
     steps: usize,
+    /// fx and fz where the run estimated them as targets (`accuracy.estimated_error.fx`).
+    friction: Option<[f64; 2]>,
 }
 
 fn key_numbers(s: &Value) -> Option<Key> {
@@ -53,6 +55,7 @@ fn key_numbers(s: &Value) -> Option<Key> {
         load_error: num(s, "pressure.load_error_rel")?,
         its: num(s, "solver.newton_iterations")?,
         steps: s.pointer("/solver/path").and_then(|p| p.as_array()).map(|a| a.len().saturating_sub(1)).unwrap_or(0),
+        friction: num(s, "accuracy.estimated_error.fx").and_then(|_| Some([num(s, "friction.fx")?, num(s, "friction.fz")?])),
     })
 }
 
@@ -155,7 +158,10 @@ pub fn check_case(name: &str, default: &Run, refined: &Run, change: f64) -> (Str
         }
         _ => (None, None),
     };
-    let fmoves = friction_moves(default, refined);
+    let fmoves = match (keys[0], keys[1]) {
+        (Some(d), Some(r)) => friction_moves(d.friction, r.friction),
+        _ => None,
+    };
     if let Some(moves) = fmoves {
         for (name, v) in ["fx", "fz"].iter().zip(moves) {
             if !(v.abs() < change) {
@@ -198,16 +204,11 @@ pub fn check_case(name: &str, default: &Run, refined: &Run, change: f64) -> (Str
     (row, failed)
 }
 
-/// How far fx and fz move from the refined run to the default one, relative to the refined
-/// run's friction coefficient sqrt(fx^2 + fz^2): where both runs estimated them as targets
-/// (`accuracy.estimated_error.fx`), else None (a mesh pair, or no friction).
-fn friction_moves(default: &Run, refined: &Run) -> Option<[f64; 2]> {
-    let values = |run: &Run| {
-        let s = run.summary.as_ref()?;
-        num(s, "accuracy.estimated_error.fx")?;
-        Some([num(s, "friction.fx")?, num(s, "friction.fz")?])
-    };
-    let (d, r) = (values(default)?, values(refined)?);
+/// How far fx and fz move from the refined run `r` to the default one `d`, relative to the
+/// refined run's friction coefficient sqrt(fx^2 + fz^2): where both runs estimated them as
+/// targets ([`Key::friction`]), else None (a mesh pair, or no friction).
+fn friction_moves(d: Option<[f64; 2]>, r: Option<[f64; 2]>) -> Option<[f64; 2]> {
+    let (d, r) = (d?, r?);
     let scale = r[0].hypot(r[1]);
     (scale > 0.0).then(|| [(d[0] - r[0]) / scale, (d[1] - r[1]) / scale])
 }
