@@ -429,9 +429,9 @@ fn sequence(levels: &[Level], q: impl Fn(&Level) -> Option<f64>) -> Option<Vec<f
 /// `slope` (d ln q / d ln xi) points to: a change to the other side is all unexplained;
 /// otherwise, or with no slope, what exceeds `e`. On one mesh that rest cannot be told
 /// from a penalty error above its estimate, so it is counted as the complementarity film's:
-/// on table2-ue2 and M = 750 it fell with the mesh (a difference of the discretisations),
-/// on cases/hard/heavy-2gpa it did not, and the complementarity film was the converged one
-/// (docs/accuracy.md, "The two cavitation models on one mesh").
+/// on fixed meshes it fell with the mesh where it arose (table2-ue2, M = 750, heavy-2gpa's
+/// side lobe), and heavy-2gpa's hc part grew where the far field was refined, which moved
+/// complementarity's hc (docs/accuracy.md, "The two cavitation models on one mesh").
 pub fn unexplained_by_penalty(d: f64, e: f64, slope: Option<f64>) -> f64 {
     match slope.filter(|s| *s != 0.0) {
         Some(s) if s * d < 0.0 => d.abs(),
