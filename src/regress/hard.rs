@@ -145,7 +145,7 @@ pub fn check_case(name: &str, default: &Run, refined: &Run, change: f64) -> (Str
             }
         }
     }
-    let (dhc, dhm) = match (keys[0], keys[1]) {
+    let (dhc, dhm, fmoves) = match (keys[0], keys[1]) {
         (Some(d), Some(r)) => {
             let (dhc, dhm) = ((d.hc - r.hc) / r.hc, (d.hm - r.hm) / r.hm);
             if !(dhc.abs() < change) {
@@ -154,13 +154,9 @@ pub fn check_case(name: &str, default: &Run, refined: &Run, change: f64) -> (Str
             if !(dhm.abs() < change) {
                 failed.push(format!("hm moves {:+.2} % between the pair", 100.0 * dhm));
             }
-            (Some(dhc), Some(dhm))
+            (Some(dhc), Some(dhm), friction_moves(d.friction, r.friction))
         }
-        _ => (None, None),
-    };
-    let fmoves = match (keys[0], keys[1]) {
-        (Some(d), Some(r)) => friction_moves(d.friction, r.friction),
-        _ => None,
+        _ => (None, None, None),
     };
     if let Some(moves) = fmoves {
         for (name, v) in ["fx", "fz"].iter().zip(moves) {
