@@ -37,12 +37,13 @@ pub struct Level {
     /// The cavitation penalty the level was solved at and its estimated error (where the
     /// penalty was staged, [`crate::app::estimate::PenaltyError`]).
     pub penalty: Option<PenaltyError>,
-    /// The level is the mesh of the level before it solved again, as complementarity: the
-    /// cavitation penalty's own error stood in the way there
-    /// ([`crate::app::estimate::penalty_in_the_way`]). In the estimate's sequence it takes that
-    /// level's place, and the levels before it count less the penalty's error this one
-    /// measured (`estimate::sequence`).
-    pub again: bool,
+    /// The level is the mesh of level `again_of` solved again, as complementarity: the
+    /// cavitation penalty's own error stood in the way of the last penalty level
+    /// ([`crate::app::estimate::penalty_in_the_way`]), whose mesh and the one before it are
+    /// solved so. In the estimate's sequence it takes that level's place, and the levels
+    /// before the first mesh solved both ways count less the penalty's error measured there
+    /// (`estimate::sequence`).
+    pub again_of: Option<usize>,
     /// How many triangles the level's marking refines for the next level (after any
     /// widening; None before it marks, or without a marking).
     pub marked: Option<usize>,
@@ -61,7 +62,7 @@ impl Level {
     pub(super) fn log_line(&self, k: usize) -> String {
         format!(
             "accuracy: level {k}{}: {} contact triangles (smallest {:.4} a){}, {} unknowns, {} Newton its, {:.1} s{}: hc = {:.5e} m, hm = {:.5e} m at ({:.3}a, {:.3}a), pmax = {:.4e} Pa{}{}; estimated error {}",
-            if self.again { format!(" (level {}'s mesh as complementarity)", k - 1) } else { String::new() },
+            self.again_of.map_or(String::new(), |j| format!(" (level {j}'s mesh as complementarity)")),
             self.contact_triangles,
             self.min_size,
             self.cut.map_or(String::new(), |c| format!(
@@ -80,7 +81,11 @@ impl Level {
             self.pmax,
             self.friction.map_or(String::new(), |f| format!(", fx = {:.5e}, fz = {:.5e}", f[0], f[1])),
             self.penalty.filter(|p| p.short()).map_or(String::new(), |p| format!(" (cavitation penalty xi = {:.3e}, short of the scene's {:e})", p.xi, p.scene_xi)),
-            self.est.map_or("- (first level)".to_string(), |e| e.describe())
+            match (self.est, self.again_of) {
+                (Some(e), _) => e.describe(),
+                (None, Some(_)) => "- (it serves the estimate of the finer mesh's film, next line)".to_string(),
+                (None, None) => "- (first level)".to_string(),
+            }
         )
     }
 }
@@ -116,13 +121,30 @@ impl Budget {
     }
 }
 
+/// The level that solved level `i`'s mesh again as complementarity ([`Level::again_of`]).
+pub fn replacement(levels: &[Level], i: usize) -> Option<(usize, &Level)> {
+    levels.iter().enumerate().find(|(_, l)| l.again_of == Some(i))
+}
+
+/// The level whose result a run that ends after `levels` writes, with its index: the last
+/// level of the estimate's sequence, one per mesh (the last penalty level, or the level
+/// that solved its mesh again as complementarity). It is the last level but after the
+/// mesh before the last penalty level's was solved again, which only serves its estimate.
+pub fn written(levels: &[Level]) -> (usize, &Level) {
+    let last = levels.len() - 1;
+    match levels.iter().rposition(|l| l.again_of.is_none()) {
+        Some(p) => replacement(levels, p).unwrap_or((p, &levels[p])),
+        None => (last, &levels[last]),
+    }
+}
+
 /// The `accuracy` object of summary.json: target, estimates, levels.
 pub(super) fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&str>) -> serde_json::Value {
-    let last = levels.last().expect("a level");
+    let (_, last) = written(levels);
     let mut report = json!({
         "target": target,
         "reached": shortfall.is_none(),
-        "estimator": format!("change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change; each adds the cavitation penalty's own error c xi^(-p) of values converging like q_inf + c xi^(-p): |d ln q / d ln xi| / p with the slope from the value's adjoint, p from the slope and the change from the staged penalty xi = 1e3 (0.1 to 1; {} where the penalty was not staged; fx and fz at the slower of hc's and hm's orders); a level solved again as complementarity on the mesh of the level before takes that level's place in the sequence, the coarser levels' values shifted by the change measured between the two, and adds the part of that change the penalty's estimate does not explain (the two models' own difference on the mesh)", crate::app::estimate::ASSUMED_PENALTY_ORDER),
+        "estimator": format!("change between the last two levels times max(1, rho/(1-rho)), rho the ratio of the last two changes (capped at 0.8; over two changes after a change below 1/8 of the one before it, 1/64 on a level made by quartering), and at least that fraction of the change before the last; after a level cut to the budget, the level before's estimate less the cut level's change, and at least that change; each adds the cavitation penalty's own error c xi^(-p) of values converging like q_inf + c xi^(-p): |d ln q / d ln xi| / p with the slope from the value's adjoint, p from the slope and the change from the staged penalty xi = 1e3 (0.1 to 1; {} where the penalty was not staged; fx and fz at the slower of hc's and hm's orders); a level solved again as complementarity on the mesh of a penalty level takes that level's place in the sequence, the coarser levels' values shifted by the change measured between the two, and adds the part of that change the penalty's estimate does not explain (the two models' own difference on the mesh); where that part alone keeps it from the target, the mesh of the penalty level before is solved again too, and the estimate of the finer film takes its last change between the two complementarity films, with nothing added", crate::app::estimate::ASSUMED_PENALTY_ORDER),
         "levels": levels.iter().enumerate().map(|(k, l)| {
             let mut v = json!({
                 "level": k, "elastic_unknowns": l.elastic_unknowns, "pressure_unknowns": l.pressure_unknowns,
@@ -149,9 +171,9 @@ pub(super) fn accuracy_report(target: f64, levels: &[Level], shortfall: Option<&
             if let Some(p) = l.penalty {
                 v["penalty"] = p.json();
             }
-            // The mesh of the level before, solved again as complementarity.
-            if l.again {
-                v["complementarity_on_the_mesh_of_level"] = json!(k - 1);
+            // The mesh of an earlier level, solved again as complementarity.
+            if let Some(j) = l.again_of {
+                v["complementarity_on_the_mesh_of_level"] = json!(j);
             }
             v
         }).collect::<Vec<_>>(),

@@ -40,9 +40,12 @@
 //! 7. A level whose cavitation penalty's own error stands between it and the target
 //!    (`estimate::penalty_in_the_way`), or alone keeps a level cut to the budget from it,
 //!    has its mesh solved again as complementarity, as the next level, and the levels after
-//!    it solve complementarity too. In the estimate's
-//!    sequence that level takes the penalty level's place, the coarser levels counted less
-//!    the penalty's error it measured (`estimate::sequence`).
+//!    it solve complementarity too. In the estimate's sequence that level takes the
+//!    penalty level's place, the coarser levels counted less the penalty's error it
+//!    measured (`estimate::sequence`). Where the two models' difference on that mesh alone
+//!    then keeps it from the target (`Estimate::models_gap_in_the_way`), the mesh of the
+//!    penalty level before it is solved again too, and the estimate's last change is
+//!    between two complementarity films.
 mod level;
 mod remedy;
 
@@ -64,7 +67,7 @@ use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
 use crate::friction::pass::FrictionResult;
 use level::accuracy_report;
-pub use level::{Budget, Cut, Level};
+pub use level::{replacement, written, Budget, Cut, Level};
 use remedy::{newton_failed, remedy, Failure, Remedy, Tried};
 use std::sync::Arc;
 use std::time::Instant;
@@ -272,9 +275,19 @@ struct Loop<'c> {
     /// The present level was made by quartering and its plain Newton failed: it is meshed
     /// again with the quartered triangles halved.
     halve_quartered: bool,
-    /// The present level is the mesh of the level before solved again as complementarity
-    /// (the cavitation penalty's own error stood in the way there).
-    again: bool,
+    /// The present level is the mesh of this level solved again as complementarity (the
+    /// cavitation penalty's own error stood in the way of the last penalty level).
+    again_of: Option<usize>,
+    /// The penalty level whose mesh the present level solves again as complementarity,
+    /// where it is not the last penalty level: that one's mesh solved again is then
+    /// `previous` ([`Loop::switch_to_complementarity`]).
+    back: Option<Solved>,
+    /// The penalty level before the last (with its index), from the switch to
+    /// complementarity until the last one's mesh solved again is judged.
+    penalty_before: Option<(usize, Solved)>,
+    /// The level before `previous`, kept while cavitation is the penalty: its mesh is solved
+    /// again too when the penalty stands in the way of a level cut to the budget.
+    before: Option<Solved>,
 }
 
 /// How a level's solve failed, with what its remedy needs.
@@ -333,7 +346,10 @@ impl<'c> Loop<'c> {
             cut: None,
             over: Vec::new(),
             halve_quartered: false,
-            again: false,
+            again_of: None,
+            back: None,
+            penalty_before: None,
+            before: None,
         }
     }
 
@@ -344,8 +360,8 @@ impl<'c> Loop<'c> {
     }
 
     /// The run's end with the level before's result, short of the target because of `why`.
-    fn short<T>(&self, scene: &Scene, prev: &Solved, k: usize, why: &str) -> Step<T> {
-        let why = short_of(self.acc.target, why, k - 1, self.levels.last().and_then(|l| l.est));
+    fn short<T>(&self, scene: &Scene, prev: &Solved, why: &str) -> Step<T> {
+        let why = short_of(self.acc.target, why, &self.levels);
         Step::end(finish(self.ctx, scene, prev, self.acc.target, &self.levels, Some(why)))
     }
 
@@ -392,7 +408,7 @@ impl<'c> Loop<'c> {
         // (cases/hard/spin-0.5deg: quartered, level 4 would have had 998,894 unknowns).
         // The marking then halves, here and in a cut below.
         // A level solved again on its own mesh was within its budget.
-        let over_budget = n > budget && !self.again;
+        let over_budget = n > budget && self.again_of.is_none();
         if let Some(prev) = self.previous.as_mut().filter(|p| over_budget && p.marking.as_ref().is_some_and(|m| m.quartered() > 0)) {
             ctx.log(format!(
                 "accuracy: level {k} would have {n} unknowns, above its budget of {budget} ({}); again with its {} quartered triangles halved",
@@ -406,7 +422,7 @@ impl<'c> Loop<'c> {
         // The level is cut to the budget: the marked triangles of largest indicator that
         // fit, once per run (a cut level is the last, below), and not when even the next
         // full level's change could not take every estimate below the target.
-        let before = self.levels.last().map_or(0, |l| l.unknowns() as u64);
+        let before = if self.levels.is_empty() { 0 } else { written(&self.levels).1.unknowns() as u64 };
         let over_what = match (by_memory, by_time) {
             (Some(m), _) => format!(
                 "level {k} would have {n} unknowns and need about {:.1} GB per rank from level {}'s peak ({:.1} GB at {} unknowns), more than {:.0} % of the {:.1} GB a rank may reach ({})",
@@ -453,9 +469,8 @@ impl<'c> Loop<'c> {
             && Estimate::cut_could_reach(&self.levels, target, false);
         if penalty_alone {
             let why = format!("{over_what}, and the cavitation penalty's part alone keeps a level cut to it from the target");
-            to_complementarity(ctx, &mut self.own, k - 1, &why);
-            self.next = prev.mesh_from.clone();
-            self.again = true;
+            let back = self.before.take();
+            self.switch_to_complementarity(back, &why);
             return Step::Again;
         }
         let refused = planned.as_ref().filter(|_| !hopeful).map(|p| {
@@ -478,7 +493,7 @@ impl<'c> Loop<'c> {
                 return Step::Again;
             }
         }
-        self.short(scene, prev, k, &format!("{over_what}{}", refused.unwrap_or_default()))
+        self.short(scene, prev, &format!("{over_what}{}", refused.unwrap_or_default()))
     }
 
     /// Steps 3, 4 and 6 of a level: its solve from the level before (with the remedies
@@ -592,8 +607,9 @@ impl<'c> Loop<'c> {
             };
         };
         // The penalty level's mesh as complementarity, from its solution.
-        if self.again {
-            return collective::agree(&ctx.world, solve_again(ctx, scene, solver, prev, k - 1)).map_err(Failed::Again);
+        if let Some(j) = self.again_of {
+            let from = self.back.as_ref().unwrap_or(prev);
+            return collective::agree(&ctx.world, solve_again(ctx, scene, solver, from, j)).map_err(Failed::Again);
         }
         let pf = FieldsOnFace::new(&prev.setup.mesh, &prev.setup.layout, &prev.sol.x);
         let p = |x: f64, z: f64| pf.at(x, z).map_or(0.0, |v| v.0);
@@ -691,9 +707,15 @@ impl<'c> Loop<'c> {
                 if crate::interrupt::agreed() != 0 || !newton_failed(ctx, &e) {
                     return Step::end(out_of_time(ctx, scene, Some(prev), k, &self.levels, e));
                 }
-                self.again = false;
-                let why =
-                    format!("level {} did not converge as complementarity from its solution with the penalty ({})", k - 1, reason(&e));
+                let j = self.again_of.take().expect("set for a level solved again");
+                self.penalty_before = None;
+                let why = format!("level {j} did not converge as complementarity from its solution with the penalty ({})", reason(&e));
+                // The mesh before: the film of the last mesh solved again keeps its estimate,
+                // and the levels after it refine that mesh.
+                let why = match self.back.take() {
+                    Some(_) => format!("{why}; level {}'s estimate stands", written(&self.levels).0),
+                    None => why,
+                };
                 match prev.marking.as_ref() {
                     Some(m) => {
                         ctx.log(format!("accuracy: {why}; the levels after it solve complementarity from its pressure"));
@@ -701,7 +723,7 @@ impl<'c> Loop<'c> {
                         self.tried_again(t0)
                     }
                     // The penalty level was the last one the budget allows.
-                    None => self.short(scene, prev, k, &why),
+                    None => self.short(scene, prev, &why),
                 }
             }
             Failed::Refined(e, remedy) => {
@@ -759,7 +781,7 @@ impl<'c> Loop<'c> {
                             source: Box::new(e),
                         }));
                     }
-                    Remedy::Short => return self.short(scene, prev, k, &format!("level {k} did not converge ({e})")),
+                    Remedy::Short => return self.short(scene, prev, &format!("level {k} did not converge ({e})")),
                     Remedy::Stop => return Step::end(out_of_time(ctx, scene, Some(prev), k, &self.levels, e)),
                 }
                 self.tried_again(t0)
@@ -819,8 +841,8 @@ impl<'c> Loop<'c> {
         let min_size = edges.iter().cloned().fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
         // The pass's adapted rule is kept for the friction goals' gradient below.
         let friction = level_friction(ctx, scene, fields)?;
-        // A level solved again takes the place of the one before it: its cut and halvings.
-        let replaced = self.levels.last().filter(|_| self.again);
+        // A level solved again takes the place of the one of its mesh: its cut and halvings.
+        let replaced = self.again_of.and_then(|j| self.levels.get(j));
         let (elastic_unknowns, pressure_unknowns) = setup.layout.counts();
         let level = Level {
             elastic_unknowns,
@@ -844,7 +866,7 @@ impl<'c> Loop<'c> {
             },
             // Set below, once the slopes are known.
             penalty: None,
-            again: std::mem::take(&mut self.again),
+            again_of: self.again_of.take(),
             marked: None,
             peak_memory_mb: collective::max_f64(&ctx.world, crate::output::peak_since_mb()),
         };
@@ -857,7 +879,9 @@ impl<'c> Loop<'c> {
         // A level cut to the budget is the last: the level after it would refine the rest of
         // its marking and more, over the budget, and would not be cut again.
         let cut_level = self.levels.last().is_some_and(|l| l.cut.is_some());
-        let may_go_on = self.refined() < acc.max_levels as usize && !cut_level;
+        // A coarser mesh solved again serves the estimate of the finer one's film: the run
+        // refines that mesh, from its marking.
+        let may_go_on = self.refined() < acc.max_levels as usize && !cut_level && self.back.is_none();
         // One adjoint LU serves the next level's marking, the speed exponents when asked for,
         // and the values' slopes in the cavitation penalty, which estimate the penalty's own
         // error: on every level that has an estimate (the second on), also the last, and on
@@ -891,9 +915,14 @@ impl<'c> Loop<'c> {
         self.levels.last_mut().expect("the level just pushed").penalty =
             penalty_of(setup, sol, [st.hc, st.hm], slopes, scene.reynolds.penalty);
         let est = Estimate::of(&self.levels);
-        let level = self.levels.last_mut().expect("the level just pushed");
-        level.est = est;
-        ctx.log(level.log_line(k));
+        // A coarser mesh solved again estimates the film of the finer one: that level's
+        // estimate is replaced.
+        let (w, _) = written(&self.levels);
+        self.levels[w].est = est;
+        ctx.log(self.levels[k].log_line(k));
+        if w != k {
+            ctx.log(format!("accuracy: level {w}'s estimated error with level {k}: {}", describe(est)));
+        }
         let reached = self.refined() >= 2 && certifies && below(est);
         let last = reached || !may_go_on;
         let exponents = match (&mut adjoint, scene.output.speed_exponents) {
@@ -932,7 +961,7 @@ impl<'c> Loop<'c> {
 
     /// Refinements so far: a level solved again on its mesh is none.
     fn refined(&self) -> usize {
-        self.levels.len().saturating_sub(1) - self.levels.iter().filter(|l| l.again).count()
+        self.levels.len().saturating_sub(1) - self.levels.iter().filter(|l| l.again_of.is_some()).count()
     }
 
     /// Steps 4, 6 and 7 after a level: the run ends at the target or a limit, or the
@@ -940,10 +969,18 @@ impl<'c> Loop<'c> {
     /// from the marking (widened when too few triangles would make it).
     fn after(&mut self, scene: &Scene, recorded: Recorded, k: usize) -> Step<()> {
         let (ctx, acc, target) = (self.ctx, self.acc, self.acc.target);
-        let Recorded { mut here, edges, reached } = recorded;
-        let est = self.levels.last().and_then(|l| l.est);
+        let Recorded { mut here, mut edges, reached } = recorded;
+        // The mesh before the last penalty level's, solved again as complementarity, served
+        // the estimate of the film of that level's mesh solved so (`previous`): the run
+        // ends with that film or refines its mesh.
+        if self.back.take().is_some() {
+            here = self.previous.take().expect("the film the level before estimated");
+            edges = longest_edges(&here.setup.mesh);
+        }
+        // The level whose film the run has: `k` but after such a level.
+        let (w, _) = written(&self.levels);
         if reached {
-            ctx.log(format!("accuracy: target {target} reached at level {k}"));
+            ctx.log(format!("accuracy: target {target} reached at level {w}"));
             return Step::end(finish(ctx, scene, &here, target, &self.levels, None));
         }
         // The mesh's refinement cannot take the penalty's own error below the target: a
@@ -952,7 +989,7 @@ impl<'c> Loop<'c> {
         // condition as complementarity, which has no such part. In the estimate the level
         // solved again takes this one's place (docs/accuracy.md, "Complementarity where it
         // dominates").
-        let in_the_way = self.levels.last().and_then(|l| l.penalty.filter(|p| penalty_in_the_way(p, l.est.as_ref(), target)));
+        let in_the_way = Some(written(&self.levels).1).and_then(|l| l.penalty.filter(|p| penalty_in_the_way(p, l.est.as_ref(), target)));
         if let Some(p) = in_the_way.filter(|_| self.own.effects.cavitation == CavitationModel::Penalty) {
             if let Err(e) = crate::interrupt::check("adaptive refinement") {
                 return Step::end(out_of_time(ctx, scene, Some(&here), k + 1, &self.levels, e));
@@ -963,27 +1000,48 @@ impl<'c> Loop<'c> {
                 100.0 * p.hm,
                 p.friction.map_or(String::new(), |[fx, fz]| format!(", fx {:.3} %, fz {:.3} %", 100.0 * fx, 100.0 * fz)),
             );
-            to_complementarity(ctx, &mut self.own, k, &why);
-            self.next = here.mesh_from.clone();
-            self.again = true;
-            self.previous = Some(here);
+            let back = self.previous.replace(here);
+            self.before = None;
+            self.switch_to_complementarity(back, &why);
             return Step::Again;
         }
+        // The last penalty level's mesh solved again, kept from the target by the two
+        // models' difference on that mesh alone: the mesh of the penalty level before it
+        // is solved again too, so that the estimate's last change is between two
+        // complementarity films, with no such difference in it (docs/accuracy.md, "The two
+        // cavitation models on one mesh").
+        if let Some((j, pen)) = self.penalty_before.take() {
+            let est = written(&self.levels).1.est;
+            if let Some(e) = est.filter(|e| e.models_gap_in_the_way(target)) {
+                if let Err(e) = crate::interrupt::check("adaptive refinement") {
+                    return Step::end(out_of_time(ctx, scene, Some(&here), k + 1, &self.levels, e));
+                }
+                ctx.log(format!(
+                    "accuracy: level {k}'s estimate ({}) is above the target by the two models' difference on its mesh alone; level {j}'s mesh is solved again as complementarity too, and the last change of the estimate is then between two complementarity films",
+                    e.describe()
+                ));
+                self.next = pen.mesh_from.clone();
+                self.again_of = Some(j);
+                self.back = Some(pen);
+                self.previous = Some(here);
+                return Step::Again;
+            }
+        }
         let (refined, max_levels) = (self.refined(), acc.max_levels as usize);
-        let short = |why: String| Step::end(finish(ctx, scene, &here, target, &self.levels, Some(short_of(target, &why, k, est))));
+        let short = |why: String| Step::end(finish(ctx, scene, &here, target, &self.levels, Some(short_of(target, &why, &self.levels))));
         if refined >= max_levels {
             return short(format!("accuracy.max_levels = {max_levels} refinement levels solved"));
         }
         // A level cut to the budget is the last (see `record`).
-        if let Some(c) = self.levels.last().and_then(|l| l.cut) {
+        if let Some(c) = written(&self.levels).1.cut {
             return short(match c.by {
                 Budget::Seconds => format!(
-                    "level {k} was cut to the time left of accuracy.max_seconds = {} s: the level after it would not end in it",
+                    "level {w} was cut to the time left of accuracy.max_seconds = {} s: the level after it would not end in it",
                     acc.max_seconds
                 ),
-                Budget::Memory => format!("level {k} was cut to the memory a rank may reach: the level after it would need more"),
+                Budget::Memory => format!("level {w} was cut to the memory a rank may reach: the level after it would need more"),
                 Budget::Unknowns => {
-                    format!("level {k} was cut to accuracy.max_unknowns = {}: the level after it would exceed it", acc.max_unknowns)
+                    format!("level {w} was cut to accuracy.max_unknowns = {}: the level after it would exceed it", acc.max_unknowns)
                 }
             });
         }
@@ -997,19 +1055,37 @@ impl<'c> Loop<'c> {
         // the level is one solve and not two ([`FEW_MARKED`]).
         if refined >= 1 {
             let marking = here.marking.as_mut().expect("marked when the loop goes on");
-            match widened(ctx, scene, &here.setup.mesh, &edges, marking, marked_next, k) {
+            match widened(ctx, scene, &here.setup.mesh, &edges, marking, marked_next, w) {
                 Ok(wide) => self.next = Some(wide),
                 Err(e) => return Step::end(out_of_time(ctx, scene, Some(&here), k + 1, &self.levels, e)),
             }
-            self.levels.last_mut().expect("the level just pushed").marked = Some(marking.count());
+            self.levels[w].marked = Some(marking.count());
         } else {
             self.next = Some(marked_next);
         }
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
             return Step::end(out_of_time(ctx, scene, Some(&here), k + 1, &self.levels, e));
         }
-        self.previous = Some(here);
+        // The level before is kept while the penalty may yet stand in the way.
+        let older = self.previous.replace(here);
+        self.before = older.filter(|_| self.own.effects.cavitation == CavitationModel::Penalty);
         Step::On(())
+    }
+
+    /// Step 7: cavitation turns to complementarity because of `why`: the last level's mesh
+    /// (`previous`) is solved again so, and the levels after it solve complementarity too.
+    /// The level before it (`back`, where it was solved with the penalty) is kept: its mesh
+    /// is solved again too when the two models' difference on the last one's alone keeps
+    /// that from the target ([`Estimate::models_gap_in_the_way`]).
+    fn switch_to_complementarity(&mut self, back: Option<Solved>, why: &str) {
+        let last = self.levels.len() - 1;
+        self.ctx.log(format!(
+            "accuracy: {why}; level {last}'s mesh is solved again, and the levels after it solved, with cavitation as complementarity (effects.cavitation = \"complementarity\"), which has no such part"
+        ));
+        self.own.effects.cavitation = CavitationModel::Complementarity;
+        self.next = self.previous.as_ref().expect("the last penalty level").mesh_from.clone();
+        self.again_of = Some(last);
+        self.penalty_before = back.filter(|b| b.cavitation == CavitationModel::Penalty && last >= 1).map(|b| (last - 1, b));
     }
 }
 
@@ -1020,15 +1096,16 @@ impl<'c> Loop<'c> {
 /// mesh part), or a level cut to the budget (whose estimate is the level before's less its
 /// change).
 fn certifies(levels: &[Level]) -> bool {
-    match levels {
-        [.., before, last] => {
-            last.again
-                || last.cut.is_some()
-                || before.marked.is_some_and(|m| m >= FEW_MARKED)
-                || last.contact_triangles as f64 >= CERTIFYING_GROWTH * before.contact_triangles as f64
-        }
-        _ => false,
+    let Some(last) = levels.last().filter(|_| levels.len() >= 2) else { return false };
+    if last.again_of.is_some() || last.cut.is_some() {
+        return true;
     }
+    // The level before on the estimate's sequence: the one of the mesh before, as solved last.
+    let before = levels.iter().enumerate().filter(|(_, l)| l.again_of.is_none()).rev().nth(1);
+    before.map(|(i, l)| replacement(levels, i).map_or(l, |(_, r)| r)).is_some_and(|before| {
+        before.marked.is_some_and(|m| m >= FEW_MARKED)
+            || last.contact_triangles as f64 >= CERTIFYING_GROWTH * before.contact_triangles as f64
+    })
 }
 
 /// The next level's mesh from level `k`'s `marking` on `mesh` (`edges`: its longest edges;
@@ -1081,16 +1158,6 @@ fn widened(
         marking.count(),
     ));
     Ok(next)
-}
-
-/// Switches the scene being solved, `own`, to cavitation as complementarity because of
-/// `why`: level `k`'s mesh is solved again as the next level (its size field is the
-/// caller's to restore), and the levels after it are solved so too.
-fn to_complementarity(ctx: &Context, own: &mut Scene, k: usize, why: &str) {
-    ctx.log(format!(
-        "accuracy: {why}; level {k}'s mesh is solved again, and the levels after it solved, with cavitation as complementarity (effects.cavitation = \"complementarity\"), which has no such part"
-    ));
-    own.effects.cavitation = CavitationModel::Complementarity;
 }
 
 /// Level `k`'s mesh solved again as complementarity (`scene`) from its solution with the
@@ -1181,7 +1248,10 @@ fn reason(e: &Error) -> String {
 /// 122,746).
 fn time_left(ctx: &Context, acc: crate::case::schema::Accuracy, levels: &[Level], previous: Option<&Solved>) -> Option<TimeLeft> {
     let monolithic = previous.is_some_and(|p| p.condensation_s.is_none());
-    let last = levels.last().filter(|_| levels.len() >= 2 && monolithic && acc.max_seconds > 0.0)?;
+    if levels.len() < 2 || !monolithic || acc.max_seconds <= 0.0 {
+        return None;
+    }
+    let last = written(levels).1;
     // Each rank has its own clock: rank 0's times decide for all, or the ranks could part
     // ways over a level that fits on one and not on another.
     let t = collective::from_rank0(&ctx.world, &[ctx.start.elapsed().as_secs_f64(), last.seconds - last.failed_seconds]);
@@ -1193,8 +1263,9 @@ fn time_left(ctx: &Context, acc: crate::case::schema::Accuracy, levels: &[Level]
 /// level's coupling grows (`condensed`). Collective: every rank gets the same bound.
 fn memory_left(ctx: &Context, levels: &[Level], previous: Option<&Solved>, condensed: bool) -> Option<MemoryLeft> {
     previous?;
+    let last = written(levels).1;
     let exponent = if condensed { memory::CONDENSED_MEMORY_EXPONENT } else { memory::LEVEL_MEMORY_EXPONENT };
-    let before = levels.last()?.unknowns() as u64;
+    let before = last.unknowns() as u64;
     let room = match crate::ehl_options::get().memory_per_rank_gb {
         Some(gb) => gb * 1024.0,
         None => {
@@ -1206,7 +1277,7 @@ fn memory_left(ctx: &Context, levels: &[Level], previous: Option<&Solved>, conde
             }
         }
     };
-    let peak_mb = levels.last()?.peak_memory_mb;
+    let peak_mb = last.peak_memory_mb;
     let rooms = collective::all_gather_f64(&ctx.world, &[room]);
     rooms.iter().map(|&room_mb| MemoryLeft { room_mb, before, peak_mb, exponent }).min_by_key(|m| m.unknowns())
 }
@@ -1220,7 +1291,7 @@ fn out_of_time(ctx: &Context, scene: &Scene, prev: Option<&Solved>, k: usize, le
         Some(prev) if crate::interrupt::agreed() == crate::interrupt::DEADLINE => {
             let acc = scene.accuracy;
             let why = format!("the time budget accuracy.max_seconds = {} s was spent during level {k}", acc.max_seconds);
-            let why = short_of(acc.target, &why, k - 1, levels.last().and_then(|l| l.est));
+            let why = short_of(acc.target, &why, levels);
             finish(ctx, scene, prev, acc.target, levels, Some(why))
         }
         _ => Err(e),
@@ -1239,7 +1310,9 @@ fn out_of_core_hint() -> &'static str {
 
 /// The message of a run that stops short of `target`: why, and which level's result is
 /// written with which estimate.
-fn short_of(target: f64, why: &str, level: usize, est: Option<Estimate>) -> String {
+fn short_of(target: f64, why: &str, levels: &[Level]) -> String {
+    let (level, written) = written(levels);
+    let est = written.est;
     format!(
         "accuracy: target {target} not reached: {why}; the result of level {level} is written with its estimated error ({})",
         describe(est)
@@ -1286,7 +1359,7 @@ fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Le
         }
         None => Outcome::Done,
     };
-    let last = levels.last().expect("a level");
+    let (_, last) = written(levels);
     Ok(Adapted {
         outcome,
         point,
@@ -1320,7 +1393,7 @@ mod tests {
             cut: None,
             halvings: 1,
             penalty: None,
-            again: false,
+            again_of: None,
             marked: Some(7),
             peak_memory_mb: 0.0,
         };
@@ -1332,7 +1405,7 @@ mod tests {
         assert!(certifies(&[level(720), level(869), level(1594)]));
         // The same mesh as complementarity, and a level cut to the budget, are judged by
         // their own estimates.
-        assert!(certifies(&[level(965), Level { again: true, ..level(965) }]));
+        assert!(certifies(&[level(965), Level { again_of: Some(0), ..level(965) }]));
         let cut = Cut { count: 10, share: 0.5, by: Budget::Unknowns };
         assert!(certifies(&[level(965), Level { cut: Some(cut), ..level(1000) }]));
         assert!(!certifies(&[level(720)]));

@@ -815,7 +815,9 @@ impl<'a> Path<'a> {
         let at_xi = if self.staged { format!(", xi = {PENALTY_START:e}") } else { String::new() };
         let load = self.scene.operating.load;
         self.nw.note(format!("Newton from {label} at L = {load} N{at_xi}: {} ({} iterations)", report.reason, report.iterations));
-        self.nw.iterations = report.iterations;
+        // The solve's own count adds to what it already counted: the iterations with the LU
+        // reused before an exact finish, a try before a new linear solver.
+        self.nw.iterations += report.iterations;
         if self.policy.line_search == "bt"
             && bt_gave_out(&report, self.nw.collapse.is_some())
             && !petsc::options::user_set("-snes_linesearch_type")?
