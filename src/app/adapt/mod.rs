@@ -282,11 +282,9 @@ struct Loop<'c> {
     /// where it is not the last penalty level: that one's mesh solved again is then
     /// `previous` ([`Loop::switch_to_complementarity`]).
     back: Option<Solved>,
-    /// The penalty level before the last (with its index), from the switch to
-    /// complementarity until the last one's mesh solved again is judged.
-    penalty_before: Option<(usize, Solved)>,
-    /// The level before `previous`, kept while cavitation is the penalty: its mesh is solved
-    /// again too when the penalty stands in the way of a level cut to the budget.
+    /// The penalty level before the last penalty level: kept while cavitation is the
+    /// penalty, for a switch to complementarity, and from the switch until the last
+    /// penalty level's mesh solved again is judged, for solving its mesh again too.
     before: Option<Solved>,
 }
 
@@ -348,7 +346,6 @@ impl<'c> Loop<'c> {
             halve_quartered: false,
             again_of: None,
             back: None,
-            penalty_before: None,
             before: None,
         }
     }
@@ -708,7 +705,7 @@ impl<'c> Loop<'c> {
                     return Step::end(out_of_time(ctx, scene, Some(prev), k, &self.levels, e));
                 }
                 let j = self.again_of.take().expect("set for a level solved again");
-                self.penalty_before = None;
+                self.before = None;
                 let why = format!("level {j} did not converge as complementarity from its solution with the penalty ({})", reason(&e));
                 // The mesh before: the film of the last mesh solved again keeps its estimate,
                 // and the levels after it refine that mesh.
@@ -989,7 +986,7 @@ impl<'c> Loop<'c> {
         // condition as complementarity, which has no such part. In the estimate the level
         // solved again takes this one's place (docs/accuracy.md, "Complementarity where it
         // dominates").
-        let in_the_way = Some(written(&self.levels).1).and_then(|l| l.penalty.filter(|p| penalty_in_the_way(p, l.est.as_ref(), target)));
+        let in_the_way = self.levels[w].penalty.filter(|p| penalty_in_the_way(p, self.levels[w].est.as_ref(), target));
         if let Some(p) = in_the_way.filter(|_| self.own.effects.cavitation == CavitationModel::Penalty) {
             if let Err(e) = crate::interrupt::check("adaptive refinement") {
                 return Step::end(out_of_time(ctx, scene, Some(&here), k + 1, &self.levels, e));
@@ -1001,7 +998,6 @@ impl<'c> Loop<'c> {
                 p.friction.map_or(String::new(), |[fx, fz]| format!(", fx {:.3} %, fz {:.3} %", 100.0 * fx, 100.0 * fz)),
             );
             let back = self.previous.replace(here);
-            self.before = None;
             self.switch_to_complementarity(back, &why);
             return Step::Again;
         }
@@ -1010,9 +1006,10 @@ impl<'c> Loop<'c> {
         // is solved again too, so that the estimate's last change is between two
         // complementarity films, with no such difference in it (docs/accuracy.md, "The two
         // cavitation models on one mesh").
-        if let Some((j, pen)) = self.penalty_before.take() {
-            let est = written(&self.levels).1.est;
-            if let Some(e) = est.filter(|e| e.models_gap_in_the_way(target)) {
+        let blocked = self.levels[w].est.filter(|e| e.models_gap_in_the_way(target));
+        if let (Some(e), Some(p)) = (blocked, self.levels[w].again_of) {
+            if let Some(pen) = self.before.take() {
+                let j = p - 1;
                 if let Err(e) = crate::interrupt::check("adaptive refinement") {
                     return Step::end(out_of_time(ctx, scene, Some(&here), k + 1, &self.levels, e));
                 }
@@ -1033,7 +1030,7 @@ impl<'c> Loop<'c> {
             return short(format!("accuracy.max_levels = {max_levels} refinement levels solved"));
         }
         // A level cut to the budget is the last (see `record`).
-        if let Some(c) = written(&self.levels).1.cut {
+        if let Some(c) = self.levels[w].cut {
             return short(match c.by {
                 Budget::Seconds => format!(
                     "level {w} was cut to the time left of accuracy.max_seconds = {} s: the level after it would not end in it",
@@ -1066,7 +1063,8 @@ impl<'c> Loop<'c> {
         if let Err(e) = crate::interrupt::check("adaptive refinement") {
             return Step::end(out_of_time(ctx, scene, Some(&here), k + 1, &self.levels, e));
         }
-        // The level before is kept while the penalty may yet stand in the way.
+        // The level before is kept while the penalty may yet stand in the way; after the
+        // switch it is no longer needed.
         let older = self.previous.replace(here);
         self.before = older.filter(|_| self.own.effects.cavitation == CavitationModel::Penalty);
         Step::On(())
@@ -1074,9 +1072,9 @@ impl<'c> Loop<'c> {
 
     /// Step 7: cavitation turns to complementarity because of `why`: the last level's mesh
     /// (`previous`) is solved again so, and the levels after it solve complementarity too.
-    /// The level before it (`back`, where it was solved with the penalty) is kept: its mesh
-    /// is solved again too when the two models' difference on the last one's alone keeps
-    /// that from the target ([`Estimate::models_gap_in_the_way`]).
+    /// The level before it (`back`, where it was solved with the penalty) is kept as
+    /// `before`: its mesh is solved again too when the two models' difference on the last
+    /// one's alone keeps that from the target ([`Estimate::models_gap_in_the_way`]).
     fn switch_to_complementarity(&mut self, back: Option<Solved>, why: &str) {
         let last = self.levels.len() - 1;
         self.ctx.log(format!(
@@ -1085,7 +1083,7 @@ impl<'c> Loop<'c> {
         self.own.effects.cavitation = CavitationModel::Complementarity;
         self.next = self.previous.as_ref().expect("the last penalty level").mesh_from.clone();
         self.again_of = Some(last);
-        self.penalty_before = back.filter(|b| b.cavitation == CavitationModel::Penalty && last >= 1).map(|b| (last - 1, b));
+        self.before = back.filter(|b| b.cavitation == CavitationModel::Penalty && last >= 1);
     }
 }
 
