@@ -46,18 +46,21 @@
 //!    then keeps it from the target (`Estimate::models_gap_in_the_way`), the mesh of the
 //!    penalty level before it is solved again too, and the estimate's last change is
 //!    between two complementarity films.
+//!
+//! This file holds the loop and steps 1-4, 6 and 7; `budget` step 5 (the budgets and the
+//! level cut to them), `remedy` the choice of a failed level's remedy, `level` the record
+//! of each level and summary.json's report, `end` the written result.
+mod budget;
+mod end;
 mod level;
 mod remedy;
 
 use super::estimate::{penalty_in_the_way, Estimate, PenaltyError, PenaltySlopes, SHORT_PENALTY_SHARE};
 use super::first_level::{closures, first_level_again, from_reached, onward, reached, without_gradient_jump, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::Setup;
-use super::marking::{
-    cut_count, goal_mark, goals, longest_edges, next_field, quarters, widened_count, zone_mark, Marking, NextMesh, TimeLeft,
-    MIN_BUDGET_SHARE,
-};
-use super::memory::{self, MemoryLeft};
-use super::point::{post_point, PointResult};
+use super::marking::{goal_mark, goals, longest_edges, next_field, quarters, widened_count, zone_mark, Marking, NextMesh};
+use super::memory;
+use super::point::PointResult;
 use super::{Context, Outcome};
 use crate::case::schema::{Accuracy, RAISED_GRADIENT_JUMP};
 use crate::case::{CavitationModel, Scene};
@@ -66,7 +69,7 @@ use crate::ehl::driver::{Coarser, Coupling, EhlSolution, EhlSolver, Milder, Ramp
 use crate::ehl::post::FieldsOnFace;
 use crate::error::{Error, Reached};
 use crate::friction::pass::FrictionResult;
-use level::accuracy_report;
+use end::{describe, finish, out_of_time, short_of};
 pub use level::{replacement, written, Budget, Cut, Level};
 use remedy::{newton_failed, remedy, Failure, Remedy, Tried};
 use std::sync::Arc;
@@ -105,35 +108,6 @@ const WIDENING_AIM: f64 = 1.1;
 /// Meshes tried for a widened marking (each a fraction of a second at the sizes where
 /// Doerfler's set is small).
 const MAX_WIDENINGS: usize = 5;
-
-/// Meshes tried for a level cut to the budget (each a fraction of a second at 600,000
-/// unknowns): a cut that still exceeds it is cut again from the meshes tried ([`cut_count`]).
-const MAX_CUTS: usize = 6;
-
-/// The cut a level over its budget leads to, before it is decided: the marking it refines
-/// a part of (`marked` triangles), the meshes tried for it with the last one over the
-/// budget (count refined, unknowns), and the `count` of largest indicator to refine with
-/// their `share` of the marked indicator ([`cut_count`]).
-struct PlannedCut<'a> {
-    marking: &'a Marking,
-    marked: usize,
-    tried: Vec<(usize, u64)>,
-    count: usize,
-    share: f64,
-}
-
-impl<'a> PlannedCut<'a> {
-    /// From `marking`, the meshes tried so far (`over`), the cut the last of them refined
-    /// (None: the whole marking), its `n` unknowns, the level before's `before` unknowns and
-    /// the `budget`. None when the marking has no ranking (zone marking).
-    fn of(marking: &'a Marking, over: &[(usize, u64)], cut: Option<Cut>, n: u64, before: u64, budget: u64) -> Option<Self> {
-        let marked = marking.ranked.as_ref()?.len();
-        let mut tried = over.to_vec();
-        tried.push((cut.map_or(marked, |c| c.count), n));
-        let count = cut_count(before, &tried, budget);
-        Some(PlannedCut { marking, marked, tried, count, share: marking.indicator_share(count) })
-    }
-}
 
 /// A solved level kept for the next one: its setup, solution, dimensionless central film
 /// and condensation time.
@@ -374,123 +348,6 @@ impl<'c> Loop<'c> {
             Ok(s) => Step::On(s),
             Err(e) => Step::end(self.stopped(scene, k, e)),
         }
-    }
-
-    /// Step 5 before the solve: a level over `accuracy.max_unknowns`, the time left or the
-    /// memory a rank may reach is meshed again with its quartered triangles halved, cut to
-    /// the budget, or not begun (the run ends with the level before's result).
-    fn within_budgets(&mut self, scene: &Scene, setup: &Setup, k: usize) -> Step<()> {
-        let (ctx, acc, target, growth) = (self.ctx, self.acc, self.acc.target, scene.mesh.growth);
-        let (n_u, n_p) = setup.layout.counts();
-        let n = (n_u + n_p + 1) as u64;
-        // The time budget as a bound on the level's unknowns: what the level before's cost
-        // per unknown lets end in the time left. A level that would not end in it is cut
-        // or not begun, rather than abandoned at the deadline after most of its cost.
-        let time = time_left(ctx, acc, &self.levels, self.previous.as_ref());
-        let by_time = time.filter(|t| t.unknowns() < acc.max_unknowns);
-        let budget = by_time.map_or(acc.max_unknowns, |t| t.unknowns());
-        // The memory as a bound too: a level the node cannot hold is cut or not begun,
-        // rather than killed with the run.
-        let condensed = Coupling::of_scene(scene, n_p, self.previous.is_some()) == Coupling::Condensed;
-        let by_memory = memory_left(ctx, &self.levels, self.previous.as_ref(), condensed).filter(|m| m.unknowns() < budget);
-        let by_time = by_time.filter(|_| by_memory.is_none());
-        let budget = by_memory.map_or(budget, |m| m.unknowns());
-        let budget_by = match (by_memory, by_time) {
-            (Some(_), _) => Budget::Memory,
-            (None, Some(_)) => Budget::Seconds,
-            (None, None) => Budget::Unknowns,
-        };
-        // Quartering saves a level; over a budget the level it would save is not reached
-        // anyway, and halving leaves room for the rest of the marking
-        // (cases/hard/spin-0.5deg: quartered, level 4 would have had 998,894 unknowns).
-        // The marking then halves, here and in a cut below.
-        // A level solved again on its own mesh was within its budget.
-        let over_budget = n > budget && self.again_of.is_none();
-        if let Some(prev) = self.previous.as_mut().filter(|p| over_budget && p.marking.as_ref().is_some_and(|m| m.quartered() > 0)) {
-            ctx.log(format!(
-                "accuracy: level {k} would have {n} unknowns, above its budget of {budget} ({}); again with its {} quartered triangles halved",
-                budget_by.key(),
-                prev.marking.as_ref().map_or(0, |m| m.quartered())
-            ));
-            self.next = prev.halved_marking(growth);
-            return Step::Again;
-        }
-        let (Some(prev), true) = (&self.previous, over_budget) else { return Step::On(()) };
-        // The level is cut to the budget: the marked triangles of largest indicator that
-        // fit, once per run (a cut level is the last, below), and not when even the next
-        // full level's change could not take every estimate below the target.
-        let before = if self.levels.is_empty() { 0 } else { written(&self.levels).1.unknowns() as u64 };
-        let over_what = match (by_memory, by_time) {
-            (Some(m), _) => format!(
-                "level {k} would have {n} unknowns and need about {:.1} GB per rank from level {}'s peak ({:.1} GB at {} unknowns), more than {:.0} % of the {:.1} GB a rank may reach ({})",
-                m.predicted(n) / 1024.0,
-                k - 1,
-                m.peak_mb / 1024.0,
-                m.before,
-                100.0 * super::memory::MEMORY_FILL,
-                m.room_mb / 1024.0,
-                match crate::ehl_options::get().memory_per_rank_gb {
-                    Some(_) => "-ehl_memory_per_rank".to_string(),
-                    None => "its memory now and its share of the node's free memory; -ehl_memory_per_rank sets it".to_string(),
-                }
-            ) + out_of_core_hint(),
-            (None, Some(t)) => format!(
-                "level {k} would have {n} unknowns and take about {:.0} s at level {}'s cost ({} unknowns in {:.0} s), more than the {:.0} s left of accuracy.max_seconds = {} s",
-                t.predicted(n),
-                k - 1,
-                t.before,
-                t.seconds,
-                t.left.max(0.0),
-                acc.max_seconds
-            ),
-            (None, None) => format!("level {k} would have {n} unknowns, above accuracy.max_unknowns = {}", acc.max_unknowns),
-        };
-        // The cut this mesh leads to (none without a ranked marking, or after
-        // [`MAX_CUTS`] meshes).
-        let planned = prev
-            .marking
-            .as_ref()
-            .filter(|_| self.over.len() < MAX_CUTS)
-            .and_then(|m| PlannedCut::of(m, &self.over, self.cut, n, before, budget))
-            .filter(|p| p.count > 0);
-        let hopeful = planned.as_ref().is_some_and(|p| {
-            Estimate::cut_worth_solving(&self.levels, target, scene.effects.cavitation == CavitationModel::Penalty, p.share)
-        });
-        // A cut level kept from the target by the cavitation penalty's part alone: the
-        // level before is solved again as complementarity, and the cut is gated and
-        // estimated on that sequence (below, step 7 of the module documentation).
-        let penalty_alone = planned.is_some()
-            && !hopeful
-            && scene.effects.cavitation == CavitationModel::Penalty
-            && self.levels.last().is_some_and(|l| l.penalty.is_some())
-            && Estimate::cut_could_reach(&self.levels, target, false);
-        if penalty_alone {
-            let why = format!("{over_what}, and the cavitation penalty's part alone keeps a level cut to it from the target");
-            let back = self.before.take();
-            self.switch_to_complementarity(back, &why);
-            return Step::Again;
-        }
-        let refused = planned.as_ref().filter(|_| !hopeful).map(|p| {
-            format!(
-                " (a level cut to it, the {} of the {} marked triangles with the largest indicator, {:.0} % of it, could not take every estimate below the target)",
-                p.count,
-                p.marked,
-                100.0 * p.share
-            )
-        });
-        if let Some(PlannedCut { marking, marked, tried, count, share }) = planned.filter(|_| hopeful) {
-            self.over = tried;
-            if share >= MIN_BUDGET_SHARE {
-                ctx.log(format!(
-                    "accuracy: {over_what}; it refines the {count} of the {marked} marked triangles with the largest indicator instead ({:.0} % of their indicator)",
-                    100.0 * share
-                ));
-                self.next = Some(NextMesh::marked(&prev.setup.mesh, &longest_edges(&prev.setup.mesh), marking, Some(count), growth));
-                self.cut = Some(Cut { count, share, by: budget_by });
-                return Step::Again;
-            }
-        }
-        self.short(scene, prev, &format!("{over_what}{}", refused.unwrap_or_default()))
     }
 
     /// Steps 3, 4 and 6 of a level: its solve from the level before (with the remedies
@@ -1238,134 +1095,11 @@ fn reason(e: &Error) -> String {
     why.split("; path:").next().unwrap_or(&why).to_string()
 }
 
-/// The time budget as it bears on the next level (with `max_seconds` set): the seconds left
-/// and the cost of the last level, when that level is a guide: solved from a coarser level
-/// (level 0 starts from the Hertz pressure) and monolithic, as every level after it is (a
-/// level condensed onto the face has another cost per unknown: on the M = 10 point the
-/// condensed level 2 took 4.2 s for 48,396 unknowns and the monolithic level 3 33 s for
-/// 122,746).
-fn time_left(ctx: &Context, acc: crate::case::schema::Accuracy, levels: &[Level], previous: Option<&Solved>) -> Option<TimeLeft> {
-    let monolithic = previous.is_some_and(|p| p.condensation_s.is_none());
-    if levels.len() < 2 || !monolithic || acc.max_seconds <= 0.0 {
-        return None;
-    }
-    let last = written(levels).1;
-    // Each rank has its own clock: rank 0's times decide for all, or the ranks could part
-    // ways over a level that fits on one and not on another.
-    let t = collective::from_rank0(&ctx.world, &[ctx.start.elapsed().as_secs_f64(), last.seconds - last.failed_seconds]);
-    Some(TimeLeft { left: acc.max_seconds - t[0], before: last.unknowns() as u64, seconds: t[1] })
-}
-
-/// The memory as it bears on the next level: the rank whose room holds the fewest unknowns
-/// ([`MemoryLeft`]), from the last level's own peak (the largest rank's), grown as the next
-/// level's coupling grows (`condensed`). Collective: every rank gets the same bound.
-fn memory_left(ctx: &Context, levels: &[Level], previous: Option<&Solved>, condensed: bool) -> Option<MemoryLeft> {
-    previous?;
-    let last = written(levels).1;
-    let exponent = if condensed { memory::CONDENSED_MEMORY_EXPONENT } else { memory::LEVEL_MEMORY_EXPONENT };
-    let before = last.unknowns() as u64;
-    let room = match crate::ehl_options::get().memory_per_rank_gb {
-        Some(gb) => gb * 1024.0,
-        None => {
-            use mpi::traits::Communicator;
-            let here = ctx.world.split_shared(0).size().max(1) as f64;
-            match (crate::output::resident_mb(), memory::node_free_mb()) {
-                (Some(r), Some(f)) => r + f / here,
-                _ => f64::INFINITY,
-            }
-        }
-    };
-    let peak_mb = last.peak_memory_mb;
-    let rooms = collective::all_gather_f64(&ctx.world, &[room]);
-    rooms.iter().map(|&room_mb| MemoryLeft { room_mb, before, peak_mb, exponent }).min_by_key(|m| m.unknowns())
-}
-
-/// After level `k` stopped with `e`: when the time budget was spent (and a level converged
-/// before), the last converged level's result, labelled as short of its target; any other
-/// error (a signal, a failure outside Newton) stops the run.
-fn out_of_time(ctx: &Context, scene: &Scene, prev: Option<&Solved>, k: usize, levels: &[Level], e: Error) -> Result<Adapted, Error> {
-    match prev {
-        // (`finish` clears the spent budget before it writes.)
-        Some(prev) if crate::interrupt::agreed() == crate::interrupt::DEADLINE => {
-            let acc = scene.accuracy;
-            let why = format!("the time budget accuracy.max_seconds = {} s was spent during level {k}", acc.max_seconds);
-            let why = short_of(acc.target, &why, levels);
-            finish(ctx, scene, prev, acc.target, levels, Some(why))
-        }
-        _ => Err(e),
-    }
-}
-
-/// What to try when the memory bounds a level: MUMPS's factors out of core, unless the
-/// user runs so already (docs/performance.md, "Factors out of core": 22 % less peak for 27 %
-/// more wall on table2-ue2 at 0.001).
-fn out_of_core_hint() -> &'static str {
-    match crate::petsc::options::get_string("-mat_mumps_icntl_22") {
-        Ok(Some(v)) if v.trim() != "0" => "",
-        _ => " (-mat_mumps_icntl_22 1 puts MUMPS's factors on disk: about a fifth less memory for a quarter more time)",
-    }
-}
-
-/// The message of a run that stops short of `target`: why, and which level's result is
-/// written with which estimate.
-fn short_of(target: f64, why: &str, levels: &[Level]) -> String {
-    let (level, written) = written(levels);
-    let est = written.est;
-    format!(
-        "accuracy: target {target} not reached: {why}; the result of level {level} is written with its estimated error ({})",
-        describe(est)
-    )
-}
-
-/// The estimate, or "none: a single level" without one.
-fn describe(est: Option<Estimate>) -> String {
-    est.map_or("none: a single level".to_string(), |e| e.describe())
-}
-
 /// The friction pass of a level, its triangles shared out over the ranks (every rank holds
 /// the whole iterate and gets the whole result; collective), or None without friction.
 fn level_friction(ctx: &Context, scene: &Scene, fields: &FieldsOnFace) -> Result<Option<FrictionResult>, Error> {
     let Some(fs) = super::lubricated::friction_setup(scene, fields.mesh.spec.contact) else { return Ok(None) };
     crate::friction::pass::friction_pass(fields, &fs, &super::lubricated::OverRanks(ctx)).map(Some)
-}
-
-/// Writes the result of `done` (the last level solved) with the accuracy report; with a
-/// `shortfall` the report says the target was not reached and the run exits 4.
-fn finish(ctx: &Context, scene: &Scene, done: &Solved, target: f64, levels: &[Level], shortfall: Option<String>) -> Result<Adapted, Error> {
-    // The budget bounds the refinement, not the writing of its result.
-    crate::interrupt::clear_deadline();
-    crate::interrupt::check("the Newton solve")?;
-    // The scene written with the result is the one its level was solved with.
-    let mut scene = scene.clone();
-    scene.reynolds.gradient_jump = done.gradient_jump;
-    scene.effects.cavitation = done.cavitation;
-    let scene = &scene;
-    let point = ctx.write_results(|dir| {
-        let point = post_point(ctx, scene, &done.setup, &done.sol, done.condensation_s, done.friction.clone(), dir)?;
-        ctx.amend_summary(dir, |summary| {
-            summary["accuracy"] = accuracy_report(target, levels, shortfall.as_deref());
-            if let Some(e) = &done.exponents {
-                summary["speed_exponents"] = e.clone();
-            }
-        })?;
-        Ok(point)
-    })?;
-    let outcome = match shortfall {
-        Some(why) => {
-            ctx.log(&why);
-            Outcome::ShortOfTarget(why)
-        }
-        None => Outcome::Done,
-    };
-    let (_, last) = written(levels);
-    Ok(Adapted {
-        outcome,
-        point,
-        estimate: last.est,
-        levels: levels.len(),
-        unknowns: last.unknowns(),
-        newton_iterations: levels.iter().map(|l| l.newton_iterations).sum(),
-    })
 }
 
 #[cfg(test)]
