@@ -4,7 +4,11 @@
 //! - `problem`: the scene as a dimensionless problem (lambda_bar, lubricant laws,
 //!   velocity field, penalty, stabilisation);
 //! - `start`: where Newton starts;
-//! - `continuation`: Newton with the continuation, a list of homotopies (parameter, ramp);
+//! - `continuation`: the path of one Newton with continuation, as a recipe (plain Newton,
+//!   the continuations, the stiff penalty, complementarity);
+//! - `newton`: the Newton solver the path's solves share (retries, the exact finish, the
+//!   line search's hand-over, one homotopy's search and ramp);
+//! - `homotopy`: the homotopies (scene parameter, ramp) and how a ramp steps;
 //! - `policy`: the coupling ([`Coupling`]) and the PETSc options each solve sets;
 //! - `diagnostics`: why the film closed, the finite-difference Jacobian check.
 //!
@@ -12,6 +16,8 @@
 mod adjoint;
 mod continuation;
 mod diagnostics;
+mod homotopy;
+mod newton;
 mod policy;
 mod problem;
 mod start;
