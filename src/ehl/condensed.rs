@@ -83,7 +83,7 @@ struct Projected {
     n: usize,
     dofs: [i32; 6],
     r: [f64; 6],
-    /// d r_a / d P_{dofs[b]}.
+    /// d r_a / d P_{dofs\[b\]}.
     dp: [[f64; 6]; 6],
     /// d r_a / d H at the element's 6 face nodes.
     dh: [[f64; 6]; 6],

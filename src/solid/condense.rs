@@ -77,7 +77,7 @@ impl Drop for OwnedIs {
     }
 }
 
-/// The P2 face mass matrix B[i][j] = integral over the face of N_i N_j for face rows
+/// The P2 face mass matrix `B[i][j]` = integral over the face of N_i N_j for face rows
 /// `rows` and pressure columns `cols` (dense, row-major).
 fn face_mass(mesh: &Mesh, rows: &[u32], cols: &[u32]) -> Vec<f64> {
     let mut row_of = vec![-1i64; mesh.nodes.len()];
