@@ -60,7 +60,7 @@ mod remedy;
 use super::estimate::{penalty_in_the_way, Estimate, PenaltyError, PenaltySlopes};
 use super::first_level::{first_level_again, Onward, FIRST_LEVEL_RETRIES};
 use super::lubricated::Setup;
-use super::marking::{goal_mark, goals, longest_edges, quarters, widened_count, zone_mark, Marking, NextMesh};
+use super::marking::{goal_mark, goals, longest_edges, quarters, widened_count, zone_mark, Goal, Marking, NextMesh};
 use super::memory;
 use super::point::PointResult;
 use super::{Context, Outcome};
@@ -68,7 +68,7 @@ use crate::case::schema::Accuracy;
 use crate::case::{CavitationModel, Scene};
 use crate::collective;
 use crate::ehl::driver::{EhlSolution, EhlSolver};
-use crate::ehl::post::FieldsOnFace;
+use crate::ehl::post::{FieldsOnFace, FilmStats};
 use crate::error::{Error, Reached};
 use crate::friction::pass::FrictionResult;
 use end::{describe, finish, out_of_time, short_of};
@@ -445,40 +445,10 @@ impl<'c> Loop<'c> {
         let (ctx, acc, target) = (self.ctx, self.acc, self.acc.target);
         let k = self.levels.len();
         let st = fields.stats();
-        let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
         let edges = longest_edges(&setup.mesh);
-        let min_size = edges.iter().cloned().fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
         // The pass's adapted rule is kept for the friction goals' gradient below.
         let friction = level_friction(ctx, scene, fields)?;
-        // A level solved again takes the place of the one of its mesh: its cut and halvings.
-        let replaced = self.again_of.and_then(|j| self.levels.get(j));
-        let (elastic_unknowns, pressure_unknowns) = setup.layout.counts();
-        let level = Level {
-            elastic_unknowns,
-            pressure_unknowns,
-            contact_triangles: setup.mesh.contact_tris.len(),
-            min_size,
-            newton_iterations: sol.newton_total,
-            seconds: self.tried_s + t0.elapsed().as_secs_f64(),
-            failed_seconds: self.tried_s,
-            hc: st.hc * hs,
-            hm: st.hm * hs,
-            hm_at: st.hm_at,
-            pmax: st.pmax * ph,
-            friction: friction.as_ref().map(|f| [f.fx, f.fz]),
-            est: None,
-            cut: replaced.map_or_else(|| self.cut.take(), |l| l.cut),
-            halvings: match replaced {
-                Some(l) => l.halvings,
-                None if k == 0 => 1,
-                None => self.next.as_ref().map_or(1, |m| m.halvings),
-            },
-            // Set below, once the slopes are known.
-            penalty: None,
-            again_of: self.again_of.take(),
-            marked: None,
-            peak_memory_mb: collective::max_f64(&ctx.world, crate::output::peak_since_mb()),
-        };
+        let level = self.level_of(scene, setup, sol, &st, &edges, friction.as_ref(), t0);
         self.over.clear();
         self.levels.push(level);
         if k == 0 && acc.max_seconds > 0.0 {
@@ -542,23 +512,7 @@ impl<'c> Loop<'c> {
         let exponents = exponents.map(|got| super::sensitivity::report(ctx, got));
         let fz_target = friction.is_some() && !setup.half;
         let quarter = quarters(est.as_ref(), target, fz_target, sol.continued);
-        let marking = if !last {
-            // A failed adjoint or goal costs this level's goal-oriented marking, not the run
-            // (an interruption is acted on at the check after the marking).
-            Some(match goals_of.filter(|_| goal) {
-                Some(Ok(goals)) => {
-                    self.zone_retry = Some(k + 1);
-                    goal_mark(ctx, scene, fields, &goals, &edges, acc.marking, quarter)
-                }
-                Some(Err(e)) => {
-                    ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
-                    Marking::unranked(zone_mark(fields, &edges))
-                }
-                None => Marking::unranked(zone_mark(fields, &edges)),
-            })
-        } else {
-            None
-        };
+        let marking = if last { None } else { Some(self.next_marking(scene, fields, goals_of.filter(|_| goal), &edges, quarter)) };
         drop(adjoint);
         // A level's time includes its adjoint and the marking of the next one.
         let pushed = self.levels.last_mut().expect("the level just pushed");
@@ -566,6 +520,79 @@ impl<'c> Loop<'c> {
         pushed.marked = marking.as_ref().map(|m| m.count());
         self.tried_s = 0.0;
         Ok(LevelEnd { marking, friction, exponents, edges, reached })
+    }
+
+    /// The record of the level just solved, before its estimate: its mesh, Newton's work,
+    /// films and friction, and where it stands in the ladder (a level solved again on an
+    /// earlier mesh takes that level's cut and halvings).
+    #[allow(clippy::too_many_arguments)]
+    fn level_of(
+        &mut self,
+        scene: &Scene,
+        setup: &Setup,
+        sol: &EhlSolution,
+        st: &FilmStats,
+        edges: &[f64],
+        friction: Option<&FrictionResult>,
+        t0: Instant,
+    ) -> Level {
+        let k = self.levels.len();
+        let (hs, ph) = (scene.scales().film_scale(), scene.hertz().ph);
+        let min_size = edges.iter().cloned().fold(f64::INFINITY, f64::min) / std::f64::consts::SQRT_2;
+        let replaced = self.again_of.and_then(|j| self.levels.get(j));
+        let (elastic_unknowns, pressure_unknowns) = setup.layout.counts();
+        Level {
+            elastic_unknowns,
+            pressure_unknowns,
+            contact_triangles: setup.mesh.contact_tris.len(),
+            min_size,
+            newton_iterations: sol.newton_total,
+            seconds: self.tried_s + t0.elapsed().as_secs_f64(),
+            failed_seconds: self.tried_s,
+            hc: st.hc * hs,
+            hm: st.hm * hs,
+            hm_at: st.hm_at,
+            pmax: st.pmax * ph,
+            friction: friction.map(|f| [f.fx, f.fz]),
+            est: None,
+            cut: replaced.map_or_else(|| self.cut.take(), |l| l.cut),
+            halvings: match replaced {
+                Some(l) => l.halvings,
+                None if k == 0 => 1,
+                None => self.next.as_ref().map_or(1, |m| m.halvings),
+            },
+            // Set by the caller, once the slopes are known.
+            penalty: None,
+            again_of: self.again_of.take(),
+            marked: None,
+            peak_memory_mb: collective::max_f64(&self.ctx.world, crate::output::peak_since_mb()),
+        }
+    }
+
+    /// Step 2 for the level just recorded: the marking the next level refines, goal-oriented
+    /// from the values' `goals` when there are some, the pressurised zone otherwise. A failed
+    /// adjoint or goal costs this level's goal-oriented marking, not the run (an
+    /// interruption is acted on at the check after the marking).
+    fn next_marking(
+        &mut self,
+        scene: &Scene,
+        fields: &FieldsOnFace,
+        goals: Option<Result<Vec<Goal>, Error>>,
+        edges: &[f64],
+        quarter: bool,
+    ) -> Marking {
+        let k = self.levels.len() - 1;
+        match goals {
+            Some(Ok(goals)) => {
+                self.zone_retry = Some(k + 1);
+                goal_mark(self.ctx, scene, fields, &goals, edges, self.acc.marking, quarter)
+            }
+            Some(Err(e)) => {
+                self.ctx.log(format!("accuracy: goal-oriented marking failed ({e}); level {} refines the pressurised zone", k + 1));
+                Marking::unranked(zone_mark(fields, edges))
+            }
+            None => Marking::unranked(zone_mark(fields, edges)),
+        }
     }
 
     /// Refinements so far: a level solved again on its mesh is none.
