@@ -65,6 +65,9 @@ pub(super) fn finish(
     scene.reynolds.gradient_jump = done.gradient_jump;
     scene.effects.cavitation = done.cavitation;
     let scene = &scene;
+    if let Some(c) = crate::app::estimate::pmax_change(levels) {
+        ctx.log(super::level::pmax_note(&c, target));
+    }
     let point = ctx.write_results(|dir| {
         let point = post_point(ctx, scene, &done.setup, &done.sol, done.condensation_s, done.friction.clone(), dir)?;
         ctx.amend_summary(dir, |summary| {
