@@ -306,6 +306,11 @@ fn a_sweep_with_a_target_refines_every_point() {
     let (slow, fast) = (summary(&run.join("point_001")), summary(&run.join("point_002")));
     assert_eq!(slow["accuracy"]["reached"], true);
     assert_eq!(fast["accuracy"]["reached"], true);
+    // pmax's change in its column: the point's own summary's, read back from the table.
+    for (r, s) in rows.iter().zip([&slow, &fast]) {
+        let change: f64 = r[col("pmax_change")].parse().unwrap_or_else(|_| panic!("pmax_change: {table}"));
+        assert!((change - num(s, "accuracy.pmax_last_change.relative")).abs() <= 1e-6 * change.abs(), "{table}");
+    }
     let (hc, hm) = (num(&slow, "film.hc_m"), num(&slow, "film.hm_m"));
     assert!((hc / 0.4595e-6 - 1.0).abs() < 0.06, "hc {hc}");
     assert!((hm / 0.3126e-6 - 1.0).abs() < 0.06, "hm {hm}");

@@ -77,6 +77,8 @@ pub struct AdaptiveRow {
     pub estimate: Option<Estimate>,
     pub levels: usize,
     pub unknowns: usize,
+    /// pmax's relative change over the last level (not a target, not estimated).
+    pub pmax_change: Option<f64>,
 }
 
 fn point_label(p: &Scene) -> String {
@@ -166,11 +168,11 @@ pub fn run_adaptive(ctx: &Context, scene: &Scene) -> Result<Outcome, Error> {
         }
         let wall_s = t0.elapsed().as_secs_f64();
         let (result, its, adaptive) = match adapted {
-            Ok(Adapted { outcome, point, estimate, levels, unknowns, newton_iterations }) => {
+            Ok(Adapted { outcome, point, estimate, levels, unknowns, newton_iterations, pmax_change }) => {
                 let reached = matches!(outcome, Outcome::Done);
                 let how = if reached { "reached the target" } else { "SHORT of the target" };
                 ctx.log(format!("sweep point {} of {} {how} ({levels} levels, {unknowns} unknowns, {wall_s:.1} s)", k + 1, n));
-                (Ok(point), newton_iterations, Some(AdaptiveRow { reached, estimate, levels, unknowns }))
+                (Ok(point), newton_iterations, Some(AdaptiveRow { reached, estimate, levels, unknowns, pmax_change }))
             }
             Err(e) => {
                 ctx.log(format!("sweep point {} of {} FAILED ({wall_s:.1} s): {e}", k + 1, n));
@@ -231,7 +233,7 @@ fn finish(ctx: &Context, scene: &Scene, rows: &[SweepRow]) -> Result<Outcome, Er
 /// `sweep.csv`: one row per point, in sweep order.
 fn write_table(ctx: &Context, rows: &[SweepRow]) -> Result<(), Error> {
     let mut t = String::from(
-        "point,ue_m_s,tilt_angle_deg,slide_to_roll,status,hc_m,hm_m,pmax_pa,load_error_rel,fx,fz,newton_iterations,wall_s,levels,unknowns,est_hc,est_hm,est_fx,est_fz,reason\n",
+        "point,ue_m_s,tilt_angle_deg,slide_to_roll,status,hc_m,hm_m,pmax_pa,load_error_rel,fx,fz,newton_iterations,wall_s,levels,unknowns,est_hc,est_hm,est_fx,est_fz,pmax_change,reason\n",
     );
     let opt = |v: Option<f64>| v.map(|x| format!("{x:e}")).unwrap_or_default();
     for (i, r) in rows.iter().enumerate() {
@@ -241,16 +243,17 @@ fn write_table(ctx: &Context, rows: &[SweepRow]) -> Result<(), Error> {
             Some(a) => {
                 let e = a.estimate;
                 format!(
-                    "{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{}",
                     a.levels,
                     a.unknowns,
                     opt(e.map(|e| e.hc)),
                     opt(e.map(|e| e.hm)),
                     opt(e.and_then(|e| e.friction).map(|f| f[0])),
-                    opt(e.and_then(|e| e.friction).map(|f| f[1]))
+                    opt(e.and_then(|e| e.friction).map(|f| f[1])),
+                    opt(a.pmax_change)
                 )
             }
-            None => ",,,,,".to_string(),
+            None => ",,,,,,".to_string(),
         };
         let status = if r.short_of_target() { "short_of_target" } else { "converged" };
         match &r.result {

@@ -93,5 +93,6 @@ pub(super) fn finish(
         levels: levels.len(),
         unknowns: last.unknowns(),
         newton_iterations: levels.iter().map(|l| l.newton_iterations).sum(),
+        pmax_change: crate::app::estimate::pmax_change(levels).map(|c| c.relative),
     })
 }

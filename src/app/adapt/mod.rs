@@ -154,6 +154,8 @@ pub struct Adapted {
     pub unknowns: usize,
     /// Newton iterations of every level (the attempts that converged).
     pub newton_iterations: usize,
+    /// pmax's relative change over the last level (`estimate::pmax_change`), not estimated.
+    pub pmax_change: Option<f64>,
 }
 
 /// What one step of a level's try leads to.
