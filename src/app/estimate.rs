@@ -462,7 +462,7 @@ pub struct PmaxChange {
 /// pmax is reported, not a target. The marking serves hc, hm (and fx, fz); where the outlet
 /// spike rises above the centre's pressure (the lighter points of the Moes map) it is
 /// resolved only where those values need it, and pmax is the highest point of the spike
-/// where the mesh happens to be finest: it moved by 11 % between the last two levels of
+/// where the mesh happens to be finest: it moved by 10 % between the last two levels of
 /// M = 200, L = 10 at target 0.0025 (docs/accuracy.md, "pmax is not a target"). Its change
 /// is a fact, not an estimate: a small one does not show that pmax has converged (the same
 /// point moved it by 0.04 % and then by 15 %). None before the second level.
