@@ -56,24 +56,28 @@ pub(super) fn write_plots(
     }
     // The film grows to tens of um at the rectangle's corners: colours and the profile's
     // film axis stop at 4 hc so the contact's film shape stays visible.
-    let hc_um = fields.stats().hc * hs * 1e6;
+    let st = fields.stats();
+    let hc_um = st.hc * hs * 1e6;
     let h_top = 4.0 * hc_um;
-    let opts = |label: &str, range: Option<(f64, f64)>| MapOpts {
+    // The places summary.json gives for hm and pmax, marked on the maps of h and p.
+    let (hm, pmax) = ((st.hm_at, "hm"), (st.pmax_at, "pmax"));
+    let opts = |label: &str, range: Option<(f64, f64)>, (at, name): ([f64; 2], &str)| MapOpts {
         circle: Some((0.0, 0.0, 1.0)),
         colorbar_label: label.to_string(),
         range,
+        markers: vec![(at, name.to_string())],
         ..MapOpts::default()
     };
-    for (name, title, vals, label, range) in [
-        ("pressure_map.png", "pressure", &pv, "p (GPa)", None),
-        ("film_map.png", "film thickness (colours saturate at 4 hc)", &hv, "h (um)", Some((0.0, h_top))),
+    for (name, title, vals, label, range, marker) in [
+        ("pressure_map.png", "pressure", &pv, "p (GPa)", None, pmax),
+        ("film_map.png", "film thickness (colours saturate at 4 hc)", &hv, "h (um)", Some((0.0, h_top)), hm),
     ] {
         let path = dir.join(name);
-        crate::output::write_atomic_with(&path, |t| map_plot(t, title, "x / a", "z / a", &tris, vals, &opts(label, range)))?;
+        crate::output::write_atomic_with(&path, |t| map_plot(t, title, "x / a", "z / a", &tris, vals, &opts(label, range, marker)))?;
     }
     // The contact itself: |x|, |z| <= 1.3 a, colours up to 1.5 hc, so the side lobes, the
     // outlet constriction and the minimum film stand out.
-    let zoom = MapOpts { x_range: Some((-1.3, 1.3)), y_range: Some((-1.3, 1.3)), ..opts("h (um)", Some((0.0, 1.5 * hc_um))) };
+    let zoom = MapOpts { x_range: Some((-1.3, 1.3)), y_range: Some((-1.3, 1.3)), ..opts("h (um)", Some((0.0, 1.5 * hc_um)), hm) };
     // The face mesh the film was solved on (an adaptive run's last level) over the film.
     let mut edges: Vec<[[f64; 2]; 2]> = Vec::new();
     let mut seen = std::collections::HashSet::new();
@@ -89,7 +93,7 @@ pub(super) fn write_plots(
             }
         }
     }
-    let with_mesh = MapOpts { edges, ..opts("h (um)", Some((0.0, h_top))) };
+    let with_mesh = MapOpts { edges, ..opts("h (um)", Some((0.0, h_top)), hm) };
     let path = dir.join("film_mesh.png");
     crate::output::write_atomic_with(&path, |t| {
         map_plot(t, "contact-face mesh over the film (colours saturate at 4 hc)", "x / a", "z / a", &tris, &hv, &with_mesh)

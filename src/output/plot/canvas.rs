@@ -20,6 +20,8 @@ pub(super) const TITLE_SIZE: f64 = 24.0;
 pub(super) const LABEL_SIZE: f64 = 19.0;
 pub(super) const TICK_SIZE: f64 = 16.0;
 pub(super) const TICK_LEN: i32 = 6;
+/// Radius in pixels of a map's point marker (`MapOpts::markers`).
+pub(super) const MARKER_RADIUS: f64 = 3.5;
 
 /// Horizontal anchor of a text.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

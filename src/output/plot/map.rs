@@ -132,6 +132,24 @@ pub fn map_plot(
     if let Some(c) = opts.circle {
         draw_circle(&mut cv, &x, &y, c, bx);
     }
+    check_finite(opts.markers.iter().flat_map(|(p, _)| *p), "map_plot: markers")?;
+    for (p, label) in &opts.markers {
+        let (px, py) = (x.px(p[0]), y.px(p[1]));
+        if px < bx.l as f64 || px > bx.r as f64 || py < bx.t as f64 || py > bx.b as f64 {
+            continue;
+        }
+        cv.disc(px, py, MARKER_RADIUS + 1.5, WHITE, bx);
+        cv.disc(px, py, MARKER_RADIUS, BLACK, bx);
+        // The label on a white band beside the dot (right of it, or left near the box's
+        // right edge), so that it reads on any colour.
+        let (tw, th) = text_size(label, TICK_SIZE);
+        let gap = MARKER_RADIUS as i32 + 5;
+        let right = px.round() as i32 + gap;
+        let lx = if right + tw + 2 <= bx.r { right } else { px.round() as i32 - gap - tw };
+        let ly = py.round() as i32;
+        cv.fill_rect(lx - 2, ly - th / 2 - 1, lx + tw + 2, ly + th / 2 + 1, WHITE);
+        cv.text(label, lx, ly, TICK_SIZE, HPos::Left, VPos::Center, false);
+    }
     // colour bar
     let cb = BoxPx { l: bx.r + cb_gap, t: bx.t, r: bx.r + cb_gap + cb_w, b: bx.b };
     for py in cb.t..cb.b {

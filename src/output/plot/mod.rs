@@ -174,6 +174,9 @@ pub struct MapOpts {
     pub y_range: Option<(f64, f64)>,
     /// Line segments drawn over the colours in data units (e.g. the edges of a mesh).
     pub edges: Vec<[[f64; 2]; 2]>,
+    /// Labelled points drawn over the colours in data units (e.g. where hm lies): a black
+    /// dot in a white ring, its label beside it; points outside the visible part are left out.
+    pub markers: Vec<([f64; 2], String)>,
 }
 
 impl Default for MapOpts {
@@ -189,6 +192,7 @@ impl Default for MapOpts {
             x_range: None,
             y_range: None,
             edges: Vec::new(),
+            markers: Vec::new(),
         }
     }
 }

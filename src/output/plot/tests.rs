@@ -73,6 +73,34 @@ fn hertz_pressure_map() {
 }
 
 #[test]
+fn a_marker_is_drawn_at_its_point_with_its_label() {
+    // A uniform field: every pixel of the plot box has one colour, except what the marker
+    // covers. The box's centre (the centroid of that colour without the marker) is where
+    // the marker at (0, 0) must be black; its label adds dark pixels to the right of it.
+    let (tris, vals) = square_mesh(1.0, 10, |_, _| 0.5);
+    let dir = test_dir();
+    let opts = MapOpts { range: Some((0.0, 1.0)), ..Default::default() };
+    let with = MapOpts { markers: vec![([0.0, 0.0], "hm".to_string())], ..opts.clone() };
+    map_plot(&dir.join("map_plain.png"), "plain", "x", "y", &tris, &vals, &opts).unwrap();
+    map_plot(&dir.join("map_marker.png"), "marker", "x", "y", &tris, &vals, &with).unwrap();
+    let (plain, marked) = (read_png(&dir.join("map_plain.png")), read_png(&dir.join("map_marker.png")));
+    let fill: Vec<(u32, u32)> =
+        (0..plain.1).flat_map(|y| (0..plain.0).map(move |x| (x, y))).filter(|&(x, y)| pixel(&plain, x, y) == viridis(0.5)).collect();
+    let n = fill.len() as f64;
+    let (cx, cy) = (fill.iter().map(|p| p.0 as f64).sum::<f64>() / n, fill.iter().map(|p| p.1 as f64).sum::<f64>() / n);
+    let (cx, cy) = (cx.round() as u32, cy.round() as u32);
+    assert_eq!(pixel(&plain, cx, cy), viridis(0.5));
+    assert_eq!(pixel(&marked, cx, cy), (0, 0, 0), "the dot at the box's centre ({cx}, {cy})");
+    let dark_right =
+        (cy - 10..cy + 10).flat_map(|y| (cx + 8..cx + 40).map(move |x| (x, y))).filter(|&(x, y)| pixel(&marked, x, y).0 < 80).count();
+    assert!(dark_right > 20, "{dark_right} dark pixels of the label right of the dot");
+    // A marker outside the visible part is left out.
+    let out = MapOpts { markers: vec![([5.0, 0.0], "far".to_string())], ..opts };
+    map_plot(&dir.join("map_far.png"), "plain", "x", "y", &tris, &vals, &out).unwrap();
+    assert!(read_png(&dir.join("map_far.png")).2 == plain.2, "a marker outside the box changed the image");
+}
+
+#[test]
 fn diverging_shear_map() {
     // signed field, rectangular domain, not equal aspect
     let (tris, vals) = square_mesh(2.0, 40, |x, y| 3e6 * x * (-(x * x + y * y)).exp());
