@@ -7,6 +7,7 @@
 //!   ehl-summary hard OUTDIR CASE... [--change F]  the hard suite's table (OUTDIR/hard.md); exit 1 on a failed check
 //!   ehl-summary curve DATA.csv OUT.png [--title T]  error against wall time, one line per
 //!       `series` of the CSV (columns series, seconds, error_pct), log-log
+//!   ehl-summary levels FILE.json            an adaptive run's levels as a Markdown table
 use clap::{Parser, Subcommand};
 use ehl_petsc::error::{Error, ResultExt};
 use ehl_petsc::regress::{self, hard, Tolerances};
@@ -54,6 +55,9 @@ enum Cmd {
         #[arg(long, default_value = "relative error against wall time")]
         title: String,
     },
+    /// An adaptive run's levels as a Markdown table: unknowns, Newton iterations, time,
+    /// memory, films, pmax and estimates per level, then the verdict
+    Levels { file: PathBuf },
 }
 
 fn read_json(p: &Path) -> Result<serde_json::Value, Error> {
@@ -121,6 +125,10 @@ fn run(cli: Cli) -> Result<i32, Error> {
             let path = outdir.join("hard.md");
             std::fs::write(&path, &md).map_err(Error::writing(&path))?;
             Ok(if n_failed == 0 { 0 } else { 1 })
+        }
+        Cmd::Levels { file } => {
+            print!("{}", regress::levels::levels_table(&read_json(&file)?).context(file.display().to_string())?);
+            Ok(0)
         }
         Cmd::Curve { data, png, title } => {
             let series = curve_series(&data)?;

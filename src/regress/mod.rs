@@ -1,8 +1,9 @@
 //! Regression checks on `summary.json` files: flattening to dotted keys, per-key
 //! tolerances, comparison against a reference with a table of what moved, and the hard
-//! suite's checks (issue 7). Pure Rust, no PETSc; used by the `ehl-summary` tool that
-//! `ci/regress` and `ci/hard` call.
+//! suite's checks (issue 7), and an adaptive run's levels as a table. Pure Rust, no PETSc;
+//! used by the `ehl-summary` tool that `ci/regress` and `ci/hard` call.
 pub mod hard;
+pub mod levels;
 
 use crate::error::Error;
 use serde_json::Value;
