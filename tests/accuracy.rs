@@ -90,6 +90,12 @@ fn a_moes_point_is_refined_to_its_target() {
     assert!((hm / 0.3126e-6 - 1.0).abs() < 0.06, "hm {hm}");
     let log = text(&out);
     assert!(log.contains("accuracy: level 2"), "{log}");
+    // `ehl-summary levels` finds every level's numbers in the summary the run wrote.
+    let table = ehl_petsc::regress::levels::levels_table(&s).unwrap();
+    for row in table.lines().skip(2).take(levels.len()) {
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        assert!(cells[1..10].iter().all(|c| !c.is_empty()), "{row}");
+    }
     // The last level's speed exponents come from the adjoint that also marks (checked
     // against two solves in `the_film_adjoints_predict_how_the_films_change_with_speed`).
     for q in ["hc", "hm"] {
