@@ -65,8 +65,9 @@ pub(super) fn finish(
     scene.reynolds.gradient_jump = done.gradient_jump;
     scene.effects.cavitation = done.cavitation;
     let scene = &scene;
-    if let Some(c) = crate::app::estimate::pmax_change(levels) {
-        ctx.log(super::level::pmax_note(&c, target));
+    let pmax_change = crate::app::estimate::pmax_change(levels);
+    if let Some(c) = &pmax_change {
+        ctx.log(super::level::pmax_note(c, target));
     }
     let point = ctx.write_results(|dir| {
         let point = post_point(ctx, scene, &done.setup, &done.sol, done.condensation_s, done.friction.clone(), dir)?;
@@ -93,6 +94,6 @@ pub(super) fn finish(
         levels: levels.len(),
         unknowns: last.unknowns(),
         newton_iterations: levels.iter().map(|l| l.newton_iterations).sum(),
-        pmax_change: crate::app::estimate::pmax_change(levels).map(|c| c.relative),
+        pmax_change: pmax_change.map(|c| c.relative),
     })
 }
